@@ -1,0 +1,81 @@
+#include "cli/args.hpp"
+
+#include <cmath>
+#include <cstdlib>
+
+#include <fmt/format.h>
+
+namespace sdfc::cli {
+
+bool Args::flag(const std::string& name) {
+    bool found = false;
+    for (size_t i = 0; i < args_.size(); ++i)
+        if (!used_[i] && args_[i] == name) used_[i] = found = true;
+    return found;
+}
+
+std::optional<std::string> Args::value(const std::string& name, const std::string& alt) {
+    std::optional<std::string> v;
+    for (size_t i = 0; i < args_.size(); ++i) {
+        if (used_[i]) continue;
+        const std::string& a = args_[i];
+        for (const std::string& n : {name, alt}) {
+            if (n.empty()) continue;
+            if (a == n) {
+                if (i + 1 >= args_.size()) throw UsageError(fmt::format("{} needs a value", n));
+                used_[i] = used_[i + 1] = true;
+                v = args_[i + 1];
+                ++i;
+                break;
+            }
+            if (a.rfind(n + "=", 0) == 0) {
+                used_[i] = true;
+                v = a.substr(n.size() + 1);
+                break;
+            }
+        }
+    }
+    return v;
+}
+
+std::vector<std::string> Args::positionals() {
+    std::vector<std::string> out;
+    for (size_t i = 0; i < args_.size(); ++i) {
+        if (used_[i]) continue;
+        if (args_[i].size() > 1 && args_[i][0] == '-' && !(args_[i].size() > 1 && (std::isdigit(static_cast<unsigned char>(args_[i][1])) || args_[i][1] == '.')))
+            throw UsageError(fmt::format("unknown option '{}' (see --help)", args_[i]));
+        out.push_back(args_[i]);
+    }
+    return out;
+}
+
+int Args::to_int(const std::string& flag, const std::string& v, long lo, long hi) {
+    char* end = nullptr;
+    long x = std::strtol(v.c_str(), &end, 10);
+    if (v.empty() || *end != '\0') throw UsageError(fmt::format("{} takes a whole number, not '{}'", flag, v));
+    if (x < lo || x > hi) throw UsageError(fmt::format("{} must be from {} to {}, not {}", flag, lo, hi, x));
+    return static_cast<int>(x);
+}
+
+float Args::to_float(const std::string& flag, const std::string& v) {
+    char* end = nullptr;
+    float x = std::strtof(v.c_str(), &end);
+    if (v.empty() || *end != '\0' || !std::isfinite(x)) throw UsageError(fmt::format("{} takes a number, not '{}'", flag, v));
+    return x;
+}
+
+std::vector<float> Args::to_floats(const std::string& flag, const std::string& v, size_t n) {
+    std::vector<float> out;
+    size_t start = 0;
+    while (start <= v.size()) {
+        size_t comma = v.find(',', start);
+        std::string part = v.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+        out.push_back(to_float(flag, part));
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    if (out.size() != n) throw UsageError(fmt::format("{} takes {} comma-separated numbers, not '{}'", flag, n, v));
+    return out;
+}
+
+}  // namespace sdfc::cli

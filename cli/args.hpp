@@ -1,0 +1,32 @@
+// A small command-line reader: flags with values, repeated positionals, and errors in the
+// same `sdfc: error:` form as everything else.
+#pragma once
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace sdfc::cli {
+
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+class Args {
+public:
+    Args(std::vector<std::string> a) : args_(std::move(a)), used_(args_.size(), false) {}
+
+    bool flag(const std::string& name);  // --name (no value)
+    std::optional<std::string> value(const std::string& name, const std::string& alt = "");  // --name V or --name=V
+    std::vector<std::string> positionals();  // everything not consumed (call last)
+
+    static int to_int(const std::string& flag, const std::string& v, long lo, long hi);
+    static float to_float(const std::string& flag, const std::string& v);
+    static std::vector<float> to_floats(const std::string& flag, const std::string& v, size_t n);
+
+private:
+    std::vector<std::string> args_;
+    std::vector<bool> used_;
+};
+
+}  // namespace sdfc::cli

@@ -1,0 +1,437 @@
+// sdfc: the command line. Each subcommand is a short function over the library stages;
+// every user error ends as `path:line:col: error:` (scripts) or `sdfc: error:` (flags), exit 1.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "cli/args.hpp"
+#include "compiler/compile.hpp"
+#include "compiler/glsl.hpp"
+#include "compiler/lower.hpp"
+#include "lang/ast.hpp"
+#include "lang/load.hpp"
+#include "runtime/atomic_file.hpp"
+#include "runtime/image.hpp"
+#include "runtime/slice.hpp"
+#include "runtime/tracer.hpp"
+#include "runtime/vm.hpp"
+
+#ifndef SDFC_VERSION
+#define SDFC_VERSION "0.0.0"
+#endif
+
+namespace sdfc::cli {
+namespace {
+
+const char* kUsage = R"(sdfc — compile and render .sdf signed-distance-field scenes
+
+usage:
+  sdfc render SCENE... -o OUT [--width W] [--height H] [--samples N] [--time T]
+              [--frames A:B --fps F] [--aov depth,normal,steps] [--view steps]
+              [--threads N] [--camera-position X,Y,Z] [--camera-target X,Y,Z] [--fov DEG] [--quiet]
+              OUT may contain {frame:04d} (or {frame}) and {name} (the scene's file stem)
+  sdfc glsl    SCENE [--target shadertoy|glsl330|html] [-o OUT]
+  sdfc compile SCENE --emit ast|ir|bytecode
+  sdfc check   SCENE
+  sdfc eval    SCENE (--at X,Y,Z | --points FILE) [--time T]
+  sdfc slice   SCENE --axis x|y|z --at V -o OUT [--range UMIN,UMAX,VMIN,VMAX] [--width W] [--height H]
+  sdfc bench   SCENE [--width W] [--height H] [--repeat N] [--threads N] [--baseline]
+  sdfc --help | --version | CMD --help
+
+SCENE is a .sdf script or a .vm model (Prospero/Fidget flat SSA format).
+Safety limits (defaults in docs/language.md): --max-recursion N, --max-iterations N,
+--max-shapes N, --max-ops N, --max-file-size BYTES, --max-pixels N (width*height*samples),
+--max-frames N, --max-nesting N.
+)";
+
+struct Common {
+    InterpretOptions interp;
+    long max_pixels = 268'435'456;  // width * height * samples
+    int max_frames = 100000;
+};
+
+Common read_common(Args& a) {
+    Common c;
+    Limits& l = c.interp.limits;
+    if (auto v = a.value("--max-recursion")) l.max_recursion = Args::to_int("--max-recursion", *v, 1, 100000);
+    if (auto v = a.value("--max-iterations")) {
+        l.max_loop_iterations = Args::to_int("--max-iterations", *v, 1, 2000000000);
+        l.max_total_iterations = std::max<long>(l.max_total_iterations, l.max_loop_iterations * 100L);
+    }
+    if (auto v = a.value("--max-shapes")) l.max_shapes = size_t(Args::to_int("--max-shapes", *v, 1, 2000000000));
+    if (auto v = a.value("--max-ops")) l.max_ops = size_t(Args::to_int("--max-ops", *v, 1, 2000000000));
+    if (auto v = a.value("--max-file-size")) l.max_file_bytes = size_t(Args::to_int("--max-file-size", *v, 1, 2000000000));
+    if (auto v = a.value("--max-nesting")) l.max_nesting = Args::to_int("--max-nesting", *v, 1, 100000);
+    if (auto v = a.value("--max-pixels")) c.max_pixels = Args::to_int("--max-pixels", *v, 1, 2000000000);
+    if (auto v = a.value("--max-frames")) c.max_frames = Args::to_int("--max-frames", *v, 1, 100000000);
+    return c;
+}
+
+std::string one_scene(Args& a, const char* cmd) {
+    auto pos = a.positionals();
+    if (pos.empty()) throw UsageError(fmt::format("{} needs a scene file", cmd));
+    if (pos.size() > 1) throw UsageError(fmt::format("{} takes one scene file, got '{}' too", cmd, pos[1]));
+    return pos[0];
+}
+
+// `{frame:04d}`, `{frame}` and `{name}` in an output path.
+std::string expand(std::string out, int frame, const std::string& name) {
+    auto replace = [&](const std::string& key, const std::string& val) {
+        for (size_t p; (p = out.find(key)) != std::string::npos;) out.replace(p, key.size(), val);
+    };
+    for (size_t p; (p = out.find("{frame:")) != std::string::npos;) {
+        size_t e = out.find('}', p);
+        if (e == std::string::npos) break;
+        std::string spec = out.substr(p + 7, e - p - 7);
+        int width = 0;
+        if (!spec.empty() && spec.back() == 'd') {
+            std::string digits = spec.substr(0, spec.size() - 1);
+            width = digits.empty() ? 0 : std::atoi(digits.c_str());
+        } else {
+            throw UsageError(fmt::format("unsupported frame format '{{frame:{}}}' (use {{frame:04d}})", spec));
+        }
+        out.replace(p, e - p + 1, fmt::format("{:0{}d}", frame, width));
+    }
+    replace("{frame}", std::to_string(frame));
+    replace("{name}", name);
+    return out;
+}
+
+void apply_overrides(CompiledScene& cs, Args& a, Common& c) {
+    if (auto v = a.value("--width")) cs.render.width = Args::to_int("--width", *v, 1, 65536);
+    if (auto v = a.value("--height")) cs.render.height = Args::to_int("--height", *v, 1, 65536);
+    if (auto v = a.value("--samples")) cs.render.samples = Args::to_int("--samples", *v, 1, 4096);
+    if (auto v = a.value("--camera-position")) {
+        auto f = Args::to_floats("--camera-position", *v, 3);
+        cs.camera.position = {f[0], f[1], f[2]};
+    }
+    if (auto v = a.value("--camera-target")) {
+        auto f = Args::to_floats("--camera-target", *v, 3);
+        cs.camera.target = {f[0], f[1], f[2]};
+    }
+    if (auto v = a.value("--fov")) {
+        float f = Args::to_float("--fov", *v);
+        if (!(f > 0 && f < 180)) throw UsageError("--fov must be between 0 and 180 degrees");
+        cs.camera.fov = f;
+    }
+    double px = double(cs.render.width) * cs.render.height * cs.render.samples;
+    if (px > double(c.max_pixels))
+        throw UsageError(fmt::format("{}x{} pixels at {} samples is over the limit of {} (raise it with --max-pixels)",
+                                     cs.render.width, cs.render.height, cs.render.samples, c.max_pixels));
+}
+
+CompiledScene build(SourceManager& sm, const std::string& path, Common& c, std::optional<float> time) {
+    InterpretOptions o = c.interp;
+    o.time = time;
+    Scene s = load_scene(sm, path, o);
+    return compile_scene(s);
+}
+
+int cmd_render(Args& a) {
+    Common c = read_common(a);
+    auto out = a.value("-o", "--output");
+    auto time_s = a.value("--time");
+    auto frames = a.value("--frames");
+    auto fps_s = a.value("--fps");
+    auto aov = a.value("--aov");
+    auto threads = a.value("--threads");
+    auto view = a.value("--view");
+    bool quiet = a.flag("--quiet") || a.flag("-q");
+    // Overrides are read per scene below; take them out of the positionals first.
+    std::vector<std::pair<std::string, std::optional<std::string>>> ov;
+    for (const char* f : {"--width", "--height", "--samples", "--camera-position", "--camera-target", "--fov"}) ov.emplace_back(f, a.value(f));
+    auto scenes = a.positionals();
+    if (scenes.empty()) throw UsageError("render needs a scene file");
+    if (!out) throw UsageError("render needs -o OUT");
+    RenderOptions ro;
+    if (threads) ro.threads = Args::to_int("--threads", *threads, 1, 1024);
+    if (aov) {
+        std::stringstream ss(*aov);
+        for (std::string item; std::getline(ss, item, ',');) {
+            const auto& known = known_aovs();
+            if (std::find(known.begin(), known.end(), item) == known.end())
+                throw UsageError(fmt::format("unknown AOV '{}' (known: depth, normal, steps)", item));
+            ro.aovs.push_back(item);
+        }
+    }
+    if (view) {
+        if (*view == "steps") ro.view = RenderView::Steps;
+        else if (*view != "shaded") throw UsageError(fmt::format("--view takes shaded or steps, not '{}'", *view));
+    }
+    int f0 = 0, f1 = 0;
+    float fps = 24.0f;
+    bool animated = frames.has_value();
+    if (frames) {
+        size_t colon = frames->find(':');
+        if (colon == std::string::npos) throw UsageError("--frames takes A:B");
+        f0 = Args::to_int("--frames", frames->substr(0, colon), 0, 1000000000);
+        f1 = Args::to_int("--frames", frames->substr(colon + 1), 0, 1000000000);
+        if (f1 < f0) throw UsageError("--frames A:B needs A <= B");
+        if (f1 - f0 + 1 > c.max_frames)
+            throw UsageError(fmt::format("{} frames is over the limit of {} (raise it with --max-frames)", f1 - f0 + 1, c.max_frames));
+        if (out->find("{frame") == std::string::npos && f1 > f0)
+            throw UsageError("rendering several frames needs {frame:04d} in the output name");
+    }
+    if (fps_s) {
+        fps = Args::to_float("--fps", *fps_s);
+        if (!(fps > 0)) throw UsageError("--fps must be positive");
+    }
+    if (scenes.size() > 1 && out->find("{name}") == std::string::npos)
+        throw UsageError("rendering several scenes needs {name} in the output name");
+    float base_time = time_s ? Args::to_float("--time", *time_s) : 0.0f;
+    for (const std::string& path : scenes) {
+        std::string name = std::filesystem::path(path).stem().string();
+        for (int f = f0; f <= f1; ++f) {
+            SourceManager sm;
+            float t = animated ? base_time + float(f) / fps : base_time;
+            CompiledScene cs = build(sm, path, c, t);
+            Args oa({});
+            std::vector<std::string> flat;
+            for (auto& [k, v] : ov)
+                if (v) { flat.push_back(k); flat.push_back(*v); }
+            Args overrides(flat);
+            apply_overrides(cs, overrides, c);
+            std::string target = expand(*out, f, name);
+            auto t0 = std::chrono::steady_clock::now();
+            Image img = cs.is_2d ? render_2d(cs, cs.render.width, cs.render.height, ro.threads) : render(cs, ro);
+            double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            write_image(target, img);
+            if (!quiet) std::fprintf(stderr, "sdfc: wrote %s (%dx%d, %.1f ms)\n", target.c_str(), img.width, img.height, ms);
+        }
+    }
+    return 0;
+}
+
+int cmd_check(Args& a) {
+    Common c = read_common(a);
+    std::string path = one_scene(a, "check");
+    SourceManager sm;
+    build(sm, path, c, 0.0f);
+    return 0;
+}
+
+int cmd_compile(Args& a) {
+    Common c = read_common(a);
+    auto emit = a.value("--emit");
+    std::string path = one_scene(a, "compile");
+    if (!emit) throw UsageError("compile needs --emit ast|ir|bytecode");
+    SourceManager sm;
+    if (*emit == "ast") {
+        if (is_vm_path(path)) throw UsageError("--emit ast needs a .sdf script");
+        const SourceFile& f = sm.load(path, Loc{}, c.interp.limits.max_file_bytes);
+        auto m = ast::parse(f, ast::ParseOptions{c.interp.limits.max_nesting});
+        std::cout << ast::dump(*m);
+        interpret_source(sm, f, c.interp);  // report semantic errors too
+        return 0;
+    }
+    if (*emit == "ir") {
+        Scene s = load_scene(sm, path, c.interp);
+        LoweredScene ls = lower_scene(*s.graph, s);
+        std::vector<NodeId> roots{ls.distance, ls.shading_distance};
+        std::vector<std::string> names{"distance", "shading.d"};
+        const char* ch[] = {"r", "g", "b", "specular", "shininess", "reflect", "transparency", "ior", "emit_r", "emit_g", "emit_b"};
+        for (int i = 0; i < kMatChannels; ++i) {
+            roots.push_back(ls.material[i]);
+            names.push_back(std::string("shading.") + ch[i]);
+        }
+        std::cout << dump_ir(*s.graph, roots, names);
+        return 0;
+    }
+    if (*emit == "bytecode") {
+        CompiledScene cs = build(sm, path, c, 0.0f);
+        std::cout << "; distance program\n" << disassemble(cs.distance) << "\n; shading program\n" << disassemble(cs.shading);
+        return 0;
+    }
+    throw UsageError(fmt::format("--emit takes ast, ir or bytecode, not '{}'", *emit));
+}
+
+int cmd_eval(Args& a) {
+    Common c = read_common(a);
+    auto at = a.value("--at");
+    auto points = a.value("--points");
+    auto time_s = a.value("--time");
+    std::string path = one_scene(a, "eval");
+    if (!at && !points) throw UsageError("eval needs --at X,Y,Z or --points FILE");
+    std::vector<float> xs, ys, zs;
+    if (at) {
+        auto f = Args::to_floats("--at", *at, 3);
+        xs.push_back(f[0]); ys.push_back(f[1]); zs.push_back(f[2]);
+    }
+    if (points) {
+        std::ifstream in(*points);
+        if (!in) throw UsageError(fmt::format("cannot open '{}'", *points));
+        std::string line;
+        int ln = 0;
+        while (std::getline(in, line)) {
+            ++ln;
+            std::istringstream ss(line);
+            float x, y, z;
+            std::string rest;
+            if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+            if (!(ss >> x >> y >> z) || (ss >> rest))
+                throw UsageError(fmt::format("{}:{}: expected three numbers \"x y z\"", *points, ln));
+            xs.push_back(x); ys.push_back(y); zs.push_back(z);
+        }
+    }
+    SourceManager sm;
+    CompiledScene cs = build(sm, path, c, time_s ? Args::to_float("--time", *time_s) : 0.0f);
+    Evaluator ev(cs.distance);
+    std::string out;
+    for (size_t i = 0; i < xs.size(); i += kBatch) {
+        int n = int(std::min<size_t>(kBatch, xs.size() - i));
+        ev.eval(&xs[i], &ys[i], &zs[i], n, cs.time);
+        for (int j = 0; j < n; ++j) out += fmt::format("{}\n", ev.output(0)[j]);
+    }
+    std::fwrite(out.data(), 1, out.size(), stdout);
+    return 0;
+}
+
+int cmd_slice(Args& a) {
+    Common c = read_common(a);
+    auto axis = a.value("--axis");
+    auto at = a.value("--at");
+    auto out = a.value("-o", "--output");
+    auto range = a.value("--range");
+    auto w = a.value("--width");
+    auto h = a.value("--height");
+    auto time_s = a.value("--time");
+    std::string path = one_scene(a, "slice");
+    if (!out) throw UsageError("slice needs -o OUT");
+    SliceOptions so;
+    if (axis) {
+        if (*axis != "x" && *axis != "y" && *axis != "z") throw UsageError(fmt::format("--axis takes x, y or z, not '{}'", *axis));
+        so.axis = (*axis)[0] - 'x';
+    }
+    if (at) so.at = Args::to_float("--at", *at);
+    if (range) {
+        auto f = Args::to_floats("--range", *range, 4);
+        so.range = {f[0], f[1], f[2], f[3]};
+        if (!(f[1] > f[0]) || !(f[3] > f[2])) throw UsageError("--range needs UMIN < UMAX and VMIN < VMAX");
+    }
+    if (w) so.width = Args::to_int("--width", *w, 1, 16384);
+    if (h) so.height = Args::to_int("--height", *h, 1, 16384);
+    SourceManager sm;
+    CompiledScene cs = build(sm, path, c, time_s ? Args::to_float("--time", *time_s) : 0.0f);
+    write_image(*out, render_slice(cs, so));
+    return 0;
+}
+
+int cmd_glsl(Args& a) {
+    Common c = read_common(a);
+    auto target = a.value("--target");
+    auto out = a.value("-o", "--output");
+    std::string path = one_scene(a, "glsl");
+    GlslTarget t = GlslTarget::Shadertoy;
+    if (target) {
+        if (*target == "shadertoy") t = GlslTarget::Shadertoy;
+        else if (*target == "glsl330") t = GlslTarget::Glsl330;
+        else if (*target == "html") t = GlslTarget::Html;
+        else throw UsageError(fmt::format("--target takes shadertoy, glsl330 or html, not '{}'", *target));
+    }
+    SourceManager sm;
+    InterpretOptions o = c.interp;
+    o.time = std::nullopt;  // `time` becomes iTime
+    Scene s = load_scene(sm, path, o);
+    std::string text = emit_glsl(s, t);
+    if (!out) {
+        std::fwrite(text.data(), 1, text.size(), stdout);
+        return 0;
+    }
+    write_text_file(*out, text);
+    return 0;
+}
+
+int cmd_bench(Args& a) {
+    Common c = read_common(a);
+    auto repeat = a.value("--repeat");
+    auto threads = a.value("--threads");
+    bool baseline = a.flag("--baseline");
+    std::vector<std::pair<std::string, std::optional<std::string>>> ov;
+    for (const char* f : {"--width", "--height"}) ov.emplace_back(f, a.value(f));
+    std::string path = one_scene(a, "bench");
+    int n = repeat ? Args::to_int("--repeat", *repeat, 1, 100000) : 5;
+    SourceManager sm;
+    CompiledScene cs = build(sm, path, c, 0.0f);
+    std::vector<std::string> flat;
+    for (auto& [k, v] : ov)
+        if (v) { flat.push_back(k); flat.push_back(*v); }
+    Args overrides(flat);
+    apply_overrides(cs, overrides, c);
+    RenderOptions ro;
+    if (threads) ro.threads = Args::to_int("--threads", *threads, 1, 1024);
+    (void)baseline;  // TODO(issue 6): RenderOptions::baseline
+    std::vector<double> ms;
+    RenderStats stats;
+    for (int i = 0; i < n; ++i) {
+        RenderStats st;
+        auto t0 = std::chrono::steady_clock::now();
+        if (cs.is_2d) render_2d(cs, cs.render.width, cs.render.height, ro.threads, baseline, &st);
+        else render(cs, ro, &st);
+        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+        stats = st;
+    }
+    std::vector<double> sorted = ms;
+    std::sort(sorted.begin(), sorted.end());
+    double median = sorted.size() % 2 ? sorted[sorted.size() / 2] : 0.5 * (sorted[sorted.size() / 2 - 1] + sorted[sorted.size() / 2]);
+    double pixels = double(cs.render.width) * cs.render.height;
+    double evals = double(stats.distance_points + stats.shading_points) / pixels;
+    std::printf("median_ms=%.3f min_ms=%.3f evals_per_pixel=%.2f\n", median, sorted.front(), evals);
+    return 0;
+}
+
+int dispatch(int argc, char** argv) {
+    std::vector<std::string> all(argv + 1, argv + argc);
+    if (all.empty() || all[0] == "--help" || all[0] == "-h" || all[0] == "help") {
+        std::fputs(kUsage, all.empty() ? stderr : stdout);
+        return all.empty() ? 1 : 0;
+    }
+    if (all[0] == "--version") {
+        std::printf("sdfc %s\n", SDFC_VERSION);
+        return 0;
+    }
+    std::string cmd = all[0];
+    Args a(std::vector<std::string>(all.begin() + 1, all.end()));
+    if (a.flag("--help") || a.flag("-h")) {
+        std::fputs(kUsage, stdout);
+        return 0;
+    }
+    if (cmd == "render") return cmd_render(a);
+    if (cmd == "check") return cmd_check(a);
+    if (cmd == "compile") return cmd_compile(a);
+    if (cmd == "eval") return cmd_eval(a);
+    if (cmd == "slice") return cmd_slice(a);
+    if (cmd == "glsl") return cmd_glsl(a);
+    if (cmd == "bench") return cmd_bench(a);
+    std::vector<std::string> cmds{"render", "glsl", "compile", "check", "eval", "slice", "bench"};
+    std::string near = nearest_name(cmd, cmds);
+    throw UsageError(near.empty() ? fmt::format("unknown command '{}' (see sdfc --help)", cmd)
+                                  : fmt::format("unknown command '{}' (did you mean `{}`?)", cmd, near));
+}
+
+}  // namespace
+}  // namespace sdfc::cli
+
+int main(int argc, char** argv) {
+    try {
+        return sdfc::cli::dispatch(argc, argv);
+    } catch (const sdfc::CompileError& e) {
+        std::string s = e.formatted();
+        std::fwrite(s.data(), 1, s.size(), stderr);
+        return 1;
+    } catch (const sdfc::cli::UsageError& e) {
+        std::fprintf(stderr, "sdfc: error: %s\n", e.what());
+        return 1;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "sdfc: error: %s\n", e.what());
+        return 1;
+    }
+}

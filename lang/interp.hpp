@@ -1,0 +1,118 @@
+// Internal to lang/: the interpreter's state, shared by interpreter.cpp (statements and
+// expressions) and builtins.cpp (the built-in shapes, operations, settings and math).
+#pragma once
+#include <deque>
+#include <optional>
+#include <string_view>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "lang/interpreter.hpp"
+#include "lang/value.hpp"
+
+namespace sdfc {
+
+struct Binding {
+    Value value;
+    bool mut = false;
+    Loc loc;
+};
+
+struct Env {
+    Env* parent = nullptr;
+    std::unordered_map<std::string, Binding> vars;
+    bool field_scope = false;  // inside a field body: `var` and assignment allowed
+    Binding* find(const std::string& name) {
+        for (Env* e = this; e; e = e->parent) {
+            auto it = e->vars.find(name);
+            if (it != e->vars.end()) return &it->second;
+        }
+        return nullptr;
+    }
+};
+
+enum class Builtin : uint16_t {
+#define SDFC_BUILTIN(id, name, kind) id,
+#include "lang/builtins.def"
+#undef SDFC_BUILTIN
+};
+
+enum class BuiltinKind { Math, Shape, Modifier, Setting, MaterialCtor };
+
+// Parameter types of builtins.
+enum class PT { Num, Vec3, NumOrVec3, Vec, Bool, String, Material, Any };
+
+struct ParamSpec {
+    const char* name;
+    PT type;
+    bool has_default = false;
+    std::array<float, 3> def{};
+};
+
+struct BuiltinInfo {
+    Builtin id;
+    const char* name;
+    BuiltinKind kind;
+    std::vector<ParamSpec> params;
+};
+
+const BuiltinInfo* find_builtin(std::string_view name);
+const BuiltinInfo& builtin_info(Builtin id);
+const std::vector<std::string>& builtin_names();
+
+class Interp {
+public:
+    Interp(SourceManager& sm, const InterpretOptions& opts);
+
+    Scene run(const SourceFile& file);
+
+    // --- evaluation (interpreter.cpp)
+    Value eval(const ast::Expr& e, Env* env);
+    Value eval_block(const ast::Block& b, Env* env, bool field_scope);
+    void exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out);
+    void exec_stmts(const std::vector<ast::StmtPtr>& stmts, Env* env, std::vector<ShapePtr>& out);
+    Value call_value(const Value& callee, const std::vector<ast::Arg>& args, Env* env, Loc loc);
+    Value call_user(const Callable& fn, const std::vector<ast::Arg>& args, Env* env, Loc loc);
+    Value apply(const ast::Expr& e, Env* env);
+    ShapePtr to_shape(const Value& v, Loc loc, const char* what);
+    ShapePtr union_of(std::vector<ShapePtr> shapes, Loc loc);
+
+    // --- builtins (builtins.cpp)
+    Value call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>& args, Env* env, Loc loc);
+    ShapePtr apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc);
+    Value call_math(const BuiltinInfo& info, std::vector<Value>& args, const std::vector<Loc>& locs, Loc loc);
+
+    // --- helpers
+    [[noreturn]] void fail(Loc loc, std::string msg);
+    NodeId num(const Value& v, Loc loc, const char* what);          // a Number (or Bool)
+    float const_num(const Value& v, Loc loc, const char* what);     // a constant Number
+    Vec3N vec3(const Value& v, Loc loc, const char* what, bool broadcast);
+    NodeId truth(const Value& v, Loc loc);                          // condition as 0/1 node
+    std::optional<bool> const_truth(const Value& v, Loc loc);
+    Value binary(ast::BinOp op, const Value& a, const Value& b, Loc loc);
+    Value unary(ast::UnOp op, const Value& a, Loc loc);
+    Value componentwise(const Value& a, Loc loc, const std::function<NodeId(NodeId)>& f);
+    Value componentwise2(const Value& a, const Value& b, Loc loc, const std::function<NodeId(NodeId, NodeId)>& f);
+    NodeId checked(NodeId n, Loc loc);  // a constant must be finite
+    ShapePtr make_shape(Shape s);
+    std::string describe(const Value& v);
+    void check_limit_iterations(long n, Loc loc);
+
+    SourceManager& sm;
+    InterpretOptions opts;
+    std::shared_ptr<Graph> g;
+    Scene scene;
+    Loc camera_at, render_at, ambient_at, background_at;
+
+    std::deque<std::unique_ptr<Env>> envs;
+    std::deque<std::unique_ptr<ast::Module>> modules;
+    Env* new_env(Env* parent, bool field_scope = false);
+
+    int call_depth = 0;
+    long total_iterations = 0;
+    size_t shape_count = 0;
+    std::vector<std::string> import_stack;          // canonical paths being imported
+    std::unordered_map<std::string, Env*> imported; // canonical path -> its definitions
+};
+
+}  // namespace sdfc

@@ -1,0 +1,34 @@
+// The script interpreter: runs a parsed module (lets, defs, loops, recursion, imports) and
+// produces the Scene. Numbers are evaluated symbolically into the IR Graph, so custom
+// fields, `time` in GLSL and the point `p` are expressions, and script constants fold away.
+#pragma once
+#include <optional>
+#include <string>
+
+#include "compiler/scene.hpp"
+#include "lang/source.hpp"
+
+namespace sdfc {
+
+struct Limits {
+    int max_recursion = 64;               // nested def calls
+    long max_loop_iterations = 100000;    // per for statement
+    long max_total_iterations = 10000000; // all loops of a run together
+    size_t max_shapes = 1000000;          // shape nodes built
+    size_t max_ops = 20000000;            // IR nodes
+    int max_nesting = 256;                // syntax nesting (parser)
+    int max_shape_depth = 4000;           // depth of the shape tree
+    size_t max_file_bytes = 16u << 20;    // per source file
+};
+
+struct InterpretOptions {
+    std::optional<float> time = 0.0f;  // nullopt: `time` stays symbolic (GLSL)
+    Limits limits;
+};
+
+// Loads, parses and runs the script at `path`. Throws CompileError with every diagnostic
+// found (independent errors in different statements are all reported).
+Scene interpret_file(SourceManager& sm, const std::string& path, const InterpretOptions& opts = {});
+Scene interpret_source(SourceManager& sm, const SourceFile& file, const InterpretOptions& opts = {});
+
+}  // namespace sdfc

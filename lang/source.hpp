@@ -1,0 +1,66 @@
+// Source files, locations and diagnostics: every stage reports through these, so any
+// error a script causes reads `path:line:col: error: message`, the line, and a caret.
+#pragma once
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sdfc {
+
+struct SourceFile {
+    std::string path;   // as the user named it (or as resolved for imports)
+    std::string text;
+    std::vector<size_t> line_starts;  // offset of each line's first byte
+
+    SourceFile(std::string path, std::string text);
+    std::string_view line(uint32_t n) const;  // 1-based, without the newline
+};
+
+// A point in a script. Cheap to copy; the file outlives every Loc (SourceManager owns it).
+struct Loc {
+    const SourceFile* file = nullptr;
+    uint32_t line = 0;  // 1-based; 0 = unknown
+    uint32_t col = 0;   // 1-based, in bytes
+    bool known() const { return file != nullptr && line != 0; }
+};
+
+struct Diagnostic {
+    Loc loc;
+    std::string message;
+};
+
+// `path:line:col: error: message`, the source line, a caret under the column.
+std::string format_diagnostic(const Diagnostic& d);
+
+// Thrown by any stage for errors the user caused. Holds one or more diagnostics.
+class CompileError : public std::runtime_error {
+public:
+    explicit CompileError(std::vector<Diagnostic> diags);
+    CompileError(Loc loc, std::string message);
+    const std::vector<Diagnostic>& diagnostics() const { return diags_; }
+    std::string formatted() const;  // all diagnostics, each formatted, joined
+
+private:
+    std::vector<Diagnostic> diags_;
+};
+
+// Owns every loaded file so Locs stay valid for the whole compilation.
+class SourceManager {
+public:
+    // Reads a file; throws CompileError at `from` (the import or command line) on failure,
+    // or for binary/invalid UTF-8 content or a file over `max_bytes`.
+    const SourceFile& load(const std::string& path, Loc from = {}, size_t max_bytes = 16u << 20);
+    const SourceFile& add(std::string path, std::string text);
+
+private:
+    std::deque<std::unique_ptr<SourceFile>> files_;
+};
+
+// Levenshtein-nearest candidate within a small distance, or "" (for "did you mean").
+std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates);
+
+}  // namespace sdfc

@@ -1,0 +1,66 @@
+// Images: linear-light float pixels plus optional AOV planes, and their files.
+//
+// Files go through OpenImageIO; the format follows the extension. png/jpg/jpeg/tif/tiff/
+// bmp/tga/... are written as 8-bit sRGB; exr and hdr as linear float. EXR carries the AOVs
+// as extra channels (`Z`, `N.x N.y N.z`, `steps`); every other format gets visualised side
+// files `STEM.depth.png`, `STEM.normal.png`, `STEM.steps.png` next to the image.
+// Every file is written to a temporary name in the target's folder and renamed onto the
+// target, so a crash never leaves a partial file and an existing output is only replaced by
+// a complete one.
+#pragma once
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sdfc {
+
+// An extra per-pixel plane: "depth" (1 channel, ray distance of the first hit, max_distance
+// for misses), "normal" (3, world-space unit normal of the first hit, 0 for misses), "steps"
+// (1, sphere-tracing steps of the primary ray).
+struct AovPlane {
+    std::string name;
+    int channels = 1;
+    std::vector<float> data;  // width * height * channels, row-major, row 0 at the top
+};
+
+struct Image {
+    int width = 0, height = 0, channels = 3;
+    std::vector<float> pixels;  // linear RGB (channels interleaved), row-major, row 0 at the top
+    std::vector<AovPlane> aovs;
+
+    Image() = default;
+    Image(int w, int h, int c = 3) : width(w), height(h), channels(c), pixels(static_cast<size_t>(w) * h * c, 0.0f) {}
+
+    float& at(int x, int y, int c) { return pixels[(static_cast<size_t>(y) * width + x) * channels + c]; }
+    float at(int x, int y, int c) const { return pixels[(static_cast<size_t>(y) * width + x) * channels + c]; }
+    const AovPlane* aov(std::string_view name) const {
+        for (const auto& a : aovs)
+            if (a.name == name) return &a;
+        return nullptr;
+    }
+};
+
+struct WriteOptions {
+    bool aov_side_files = true;  // non-EXR formats: write STEM.NAME.png for each AOV plane
+};
+
+// Throws std::runtime_error (with the path and the reason) on failure; the target is then
+// left as it was and no temporary file remains.
+void write_image(const std::string& path, const Image& img, const WriteOptions& opt = {});
+
+// Reads any format OpenImageIO knows. 8-bit (and other integer) files are decoded from sRGB
+// to linear; float files are taken as linear. Channels named Z / N.x N.y N.z / steps become
+// the AOV planes depth / normal / steps; the rest are the colour channels.
+Image read_image(const std::string& path);
+
+// The side-file name of an AOV plane: "dir/out.png" + "depth" -> "dir/out.depth.png".
+std::string aov_side_path(const std::string& path, const std::string& aov);
+
+float linear_to_srgb(float v);
+float srgb_to_linear(float v);
+
+// A heat-map colour for t in [0, 1] (dark blue -> magenta -> orange -> pale yellow), as
+// display (sRGB-encoded) values in [0, 1]. Used by the steps view and the steps side file.
+void heat_color(float t, float rgb[3]);
+
+}  // namespace sdfc

@@ -1,0 +1,903 @@
+// The CPU sphere tracer. Design (all per tile, all batched through the 64-lane Evaluator):
+//
+//  * Primary rays: `samples` per pixel on a Hammersley pattern ((i+0.5)/S, radical_inverse(i)
+//    + 0.5/S), the same pattern in every pixel, reconstructed with a box filter over the pixel
+//    (equal weights). With aa == "cone", one cone per pixel instead (Hart's cone tracing,
+//    below), and `samples` is ignored.
+//  * Marching: a ray hits when d < epsilon * max(t, 1) (t = path length from the eye, so the
+//    tolerance grows with distance like the pixel footprint, but never below epsilon); it
+//    misses when t passes max_distance or the scene's bounding box. A ray that runs out of
+//    max_steps counts as a hit if it is within one pixel footprint of the surface, else a
+//    miss. NaN distances end the ray as a miss, +inf steps to the end, -inf is a hit.
+//  * Normals: tetrahedron technique, n = sum_k k * f(p + e*k) over k in {(1,-1,-1), (-1,-1,1),
+//    (-1,1,-1), (1,1,1)}, e = max(epsilon * max(t, 1), 2e-5 * (1 + |p|)).
+//  * Shading (Blinn-Phong, not energy normalised):
+//        emission + albedo * ambient * ao
+//        + sum_lights  colour * intensity * falloff * shadow * (albedo * max(N.L, 0)
+//                      + specular * max(N.H, 0)^shininess)              (when N.L > 0)
+//    falloff = 1 / distance^2 for point lights, 1 for directional lights.
+//  * Shadows: hard (a march toward the light, any hit = 0) when radius == 0, else soft:
+//    Quilez's penumbra estimate with the closest-approach refinement (h, previous h) and the
+//    inner/outer-penumbra form: res = min(d_closest / (w * t)), marching through occluders,
+//    vis = 0.25 (1 + res)^2 (2 - res) for res in [-1, 1]. w = radius / distance for point
+//    lights, w = radius (tangent of the angular radius) for directional ones.
+//  * Ambient occlusion: 5 taps along the normal at h = 0.01 .. 0.13 (world units),
+//    ao = clamp(1 - 3 * sum (h - d(p + n h)) * 0.95^i, 0, 1); it scales the ambient term.
+//  * Reflection/refraction, iterative (a wavefront of ray generations, not recursion), at
+//    most max_bounces generations after the primary one. At a surface with weight W:
+//    local shading gets W (1 - reflect)(1 - transparency), the mirror ray W * reflect, and
+//    the glass part W (1 - reflect) transparency splits by Schlick's Fresnel F into a
+//    reflected ray (F) and a refracted one ((1 - F) * colour, i.e. tinted glass). Inside a
+//    solid the ray marches on -d; at the exit it refracts out (1 - F) and reflects back in
+//    (F), or reflects totally. When no bounce is left the surface is shaded as opaque
+//    (and a ray inside glass is dropped). Rays below 1e-3 of a sample's weight are dropped.
+//  * Cone tracing (aa == "cone"): the cone's radius is the pixel footprint r(t). Where the
+//    ray passes an edge (d < r without hitting), the closest approach (smallest d/r) is
+//    recorded as a partial hit of coverage 1 - d/r; up to 4 such layers are composited front
+//    to back, then the final hit (or the background) gets the remaining weight.
+//  * AOVs: depth = first-hit distance (max_distance for misses; per pixel the minimum over
+//    samples), normal = unit world normal of the first hit (sample average, renormalised),
+//    steps = average primary-ray step count.
+//  * 2D models (CompiledScene::is_2d): W x H samples over [-1, 1]^2 including both ends,
+//    row 0 at y = +1, white where the field is < 0, black elsewhere.
+// FP exceptions are never unmasked here, so GCC may if-convert float compares: the lane
+// update loops below vectorise only with this.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("no-trapping-math")
+#endif
+#include "runtime/tracer.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include "runtime/camera.hpp"
+#include "runtime/vm.hpp"
+
+namespace sdfc {
+
+const std::vector<std::string>& known_aovs() {
+    static const std::vector<std::string> k{"depth", "normal", "steps"};
+    return k;
+}
+
+namespace {
+
+constexpr int kConeEvents = 4;
+constexpr int kAoTaps = 5;
+constexpr float kMinWeight = 1e-3f;
+constexpr int kMatOut = kMatChannels;  // material channels after the distance output
+
+// Rays (or hit points) in structure-of-arrays form. For a hit set, `o` is the hit point and
+// `t0` the path length from the eye to it.
+struct RaySet {
+    std::vector<float> ox, oy, oz, dx, dy, dz, tmin, tmax, t0, wr, wg, wb;
+    std::vector<uint32_t> prim;  // primary sample index within the tile
+    std::vector<uint8_t> inside;
+    size_t size() const { return n_; }
+    void clear() { n_ = 0; }
+    // Arrays are only grown, never shrunk: pushing is a bounds check and twelve stores.
+    void push(const glm::vec3& o, const glm::vec3& d, float t_min, float t_max, float path, const glm::vec3& w, uint32_t p,
+              bool in) {
+        if (n_ == ox.size()) grow();
+        const size_t i = n_++;
+        ox[i] = o.x, oy[i] = o.y, oz[i] = o.z;
+        dx[i] = d.x, dy[i] = d.y, dz[i] = d.z;
+        tmin[i] = t_min, tmax[i] = t_max, t0[i] = path;
+        wr[i] = w.x, wg[i] = w.y, wb[i] = w.z;
+        prim[i] = p;
+        inside[i] = in ? 1 : 0;
+    }
+    glm::vec3 o(size_t i) const { return {ox[i], oy[i], oz[i]}; }
+    glm::vec3 d(size_t i) const { return {dx[i], dy[i], dz[i]}; }
+    glm::vec3 w(size_t i) const { return {wr[i], wg[i], wb[i]}; }
+
+private:
+    size_t n_ = 0;
+    void grow() {
+        const size_t cap = std::max<size_t>(256, ox.size() * 2);
+        for (auto* v : {&ox, &oy, &oz, &dx, &dy, &dz, &tmin, &tmax, &t0, &wr, &wg, &wb}) v->resize(cap);
+        prim.resize(cap);
+        inside.resize(cap);
+    }
+};
+
+float radical_inverse2(uint32_t i) {
+    i = (i << 16) | (i >> 16);
+    i = ((i & 0x55555555u) << 1) | ((i & 0xAAAAAAAAu) >> 1);
+    i = ((i & 0x33333333u) << 2) | ((i & 0xCCCCCCCCu) >> 2);
+    i = ((i & 0x0F0F0F0Fu) << 4) | ((i & 0xF0F0F0F0u) >> 4);
+    i = ((i & 0x00FF00FFu) << 8) | ((i & 0xFF00FF00u) >> 8);
+    return static_cast<float>(i) * 2.3283064365386963e-10f;
+}
+
+float nonneg(float v) { return v > 0.0f ? (std::isfinite(v) ? v : 1e30f) : 0.0f; }  // NaN -> 0
+float clamp01(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }
+float max3(const glm::vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+float maxabs3(const glm::vec3& v) { return std::max(std::fabs(v.x), std::max(std::fabs(v.y), std::fabs(v.z))); }
+
+float schlick(float cos_theta, float ior) {
+    float r0 = (ior - 1.0f) / (ior + 1.0f);
+    r0 *= r0;
+    float m = 1.0f - clamp01(cos_theta);
+    float m2 = m * m;
+    return r0 + (1.0f - r0) * m2 * m2 * m;
+}
+
+// Everything the workers share, resolved once per render.
+struct Frame {
+    const CompiledScene* scene = nullptr;
+    Camera camera;
+    int width = 0, height = 0, samples = 1, tile = 16, max_steps = 256, max_bounces = 3;
+    float eps = 1e-4f, max_dist = 100.0f, time = 0.0f;
+    bool cone = false, shadows = true, ao = true, has_distance = true, has_material = true;
+    bool clip = false;
+    glm::vec3 lo{0}, hi{0};
+    std::vector<glm::vec2> offsets;
+    bool want_depth = false, want_normal = false, want_steps = false;
+    RenderView view = RenderView::Shaded;
+    glm::vec3 ambient{0}, background{0};
+
+    explicit Frame(const CompiledScene& s) : scene(&s), camera(s.camera, std::max(s.render.width, 1), std::max(s.render.height, 1)) {}
+
+    float thr(float path) const { return eps * std::max(path, 1.0f); }
+    float footprint(float path) const { return camera.footprint_base() + camera.footprint_slope() * path; }
+    float bias(const glm::vec3& p, float path) const { return 4.0f * thr(path) + 2e-5f * (1.0f + maxabs3(p)); }
+
+    // Clips [t_min, t_max] to the bounding box; an empty interval becomes t_min = +inf.
+    void clip_ray(const glm::vec3& o, const glm::vec3& d, float& t_min, float& t_max) const {
+        if (!clip) return;
+        for (int a = 0; a < 3; ++a) {
+            if (std::fabs(d[a]) < 1e-30f) {
+                if (o[a] < lo[a] || o[a] > hi[a]) t_min = INFINITY;
+                continue;
+            }
+            float inv = 1.0f / d[a];
+            float t1 = (lo[a] - o[a]) * inv, t2 = (hi[a] - o[a]) * inv;
+            if (t1 > t2) std::swap(t1, t2);
+            t_min = std::max(t_min, t1);
+            t_max = std::min(t_max, t2);
+        }
+        if (!(t_min <= t_max)) t_min = INFINITY;
+    }
+};
+
+// The lane window: up to kBatch rays in flight, structure of arrays so that the per-step
+// work (point gather, the distance update) vectorises. Finished lanes are refilled with the
+// last lane (swap-remove) and then from the queue.
+struct Lanes {
+    alignas(64) float ox[kBatch], oy[kBatch], oz[kBatch], dx[kBatch], dy[kBatch], dz[kBatch];
+    alignas(64) float t[kBatch], tmax[kBatch], t0[kBatch], sg[kBatch], w[kBatch], a[kBatch], b[kBatch];
+    alignas(64) float x[kBatch], y[kBatch], z[kBatch];
+    alignas(64) int32_t steps[kBatch], done[kBatch];
+    alignas(64) uint32_t ray[kBatch];
+    void load(int i, const RaySet& rs, uint32_t r) {
+        ox[i] = rs.ox[r], oy[i] = rs.oy[r], oz[i] = rs.oz[r];
+        dx[i] = rs.dx[r], dy[i] = rs.dy[r], dz[i] = rs.dz[r];
+        t[i] = rs.tmin[r], tmax[i] = rs.tmax[r], t0[i] = rs.t0[r];
+        sg[i] = rs.inside[r] ? -1.0f : 1.0f;
+        w[i] = 0.0f, a[i] = 0.0f, b[i] = 0.0f;
+        steps[i] = 0, done[i] = 0;
+        ray[i] = r;
+    }
+    void move(int from, int to) {
+        ox[to] = ox[from], oy[to] = oy[from], oz[to] = oz[from];
+        dx[to] = dx[from], dy[to] = dy[from], dz[to] = dz[from];
+        t[to] = t[from], tmax[to] = tmax[from], t0[to] = t0[from], sg[to] = sg[from];
+        w[to] = w[from], a[to] = a[from], b[to] = b[from];
+        steps[to] = steps[from], done[to] = done[from], ray[to] = ray[from];
+    }
+};
+
+class Worker {
+public:
+    explicit Worker(const Frame& f) : f_(f), dist_(f.scene->distance) {
+        if (f.has_material) shade_ = std::make_unique<Evaluator>(f.scene->shading);
+    }
+
+    void render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* depth, AovPlane* normal, AovPlane* steps);
+    void render_tile_2d(int x0, int y0, int x1, int y1, Image& img, AovPlane* depth);
+
+    RenderStats stats;
+
+private:
+    const Frame& f_;
+    Evaluator dist_;
+    std::unique_ptr<Evaluator> shade_;
+
+    // Scratch, reused tile after tile (no allocation once warm).
+    RaySet rays_, next_, hits_, shadow_;
+    std::vector<float> t_, accum_, px_, py_, pz_, pd_, nx_, ny_, nz_, mat_, vis_, sw_;
+    std::vector<uint8_t> hit_;
+    std::vector<int> steps_;
+    std::vector<float> prim_depth_, prim_steps_, prim_n_, prim_aw_;
+    std::vector<float> ev_t_, ev_w_, trans_;
+    std::vector<int> ev_n_;
+    std::vector<uint32_t> local_, sh_idx_;
+    std::vector<float> lw_, lnx_, lny_, lnz_, ao_, lrad_;
+
+    Lanes lanes_;
+
+    // Runs the rays of `rs` through the lane window. `init(L, i)` sets up lane i after its
+    // ray is loaded; `update(L, n, d)` consumes the distances of lanes [0, n) (a vectorisable
+    // loop that advances t and sets L.done); `finish(L, i)` records a finished lane. Rays
+    // with an empty [tmin, tmax] go to `skip(r)` without an evaluation.
+    template <class Init, class Update, class Finish, class Skip>
+    void run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish, Skip&& skip) {
+        Lanes& L = lanes_;
+        int n = 0;
+        size_t next = 0;
+        const size_t count = rs.size();
+        for (;;) {
+            while (n < kBatch && next < count) {
+                const uint32_t r = static_cast<uint32_t>(next++);
+                if (!(rs.tmin[r] <= rs.tmax[r])) {
+                    skip(r);
+                    continue;
+                }
+                L.load(n, rs, r);
+                init(L, n);
+                ++n;
+            }
+            if (n == 0) return;
+            for (int i = 0; i < n; ++i) {
+                L.x[i] = L.ox[i] + L.t[i] * L.dx[i];
+                L.y[i] = L.oy[i] + L.t[i] * L.dy[i];
+                L.z[i] = L.oz[i] + L.t[i] * L.dz[i];
+            }
+            dist_.eval(L.x, L.y, L.z, n, f_.time);
+            stats.distance_points += static_cast<uint64_t>(n);
+            update(L, n, dist_.output(0));
+            for (int i = 0; i < n;) {
+                if (L.done[i]) {
+                    finish(L, i);
+                    if (i != --n) L.move(n, i);
+                } else {
+                    ++i;
+                }
+            }
+        }
+    }
+
+    // Distance at `count` arbitrary points.
+    void eval_points(const float* x, const float* y, const float* z, size_t count, float* out) {
+        for (size_t i = 0; i < count; i += kBatch) {
+            const int m = static_cast<int>(std::min<size_t>(kBatch, count - i));
+            dist_.eval(x + i, y + i, z + i, m, f_.time);
+            std::copy_n(dist_.output(0), m, out + i);
+        }
+        stats.distance_points += count;
+    }
+
+    void push_primary(RaySet& rs, const Ray& r, float weight, uint32_t prim) {
+        float tmin = 0.0f, tmax = f_.max_dist;
+        f_.clip_ray(r.origin, r.dir, tmin, tmax);
+        rs.push(r.origin, r.dir, tmin, tmax, 0.0f, glm::vec3(weight), prim, false);
+    }
+    void push_secondary(RaySet& rs, const glm::vec3& o, const glm::vec3& d, float path, const glm::vec3& w, uint32_t prim,
+                        bool in) {
+        float tmin = 0.0f, tmax = f_.max_dist;
+        f_.clip_ray(o, d, tmin, tmax);
+        rs.push(o, d, tmin, tmax, path, w, prim, in);
+    }
+
+    void march(const RaySet& rs);
+    void cone_march(const RaySet& rs);
+    void compute_normals(const RaySet& h);
+    void compute_materials(const RaySet& h);
+    void shadow_hard(const RaySet& rs);
+    void shadow_soft(const RaySet& rs);
+    void shade(const RaySet& h, int gen, RaySet& next);
+    void add(uint32_t prim, const glm::vec3& c) {
+        const size_t p = prim / static_cast<uint32_t>(f_.samples);
+        accum_[p * 3 + 0] += c.x;
+        accum_[p * 3 + 1] += c.y;
+        accum_[p * 3 + 2] += c.z;
+    }
+};
+
+// Sphere tracing (outside rays on d, inside rays on -d). Results in t_, hit_, steps_.
+void Worker::march(const RaySet& rs) {
+    const size_t n = rs.size();
+    t_.resize(n);
+    hit_.assign(n, 0);
+    steps_.assign(n, 0);
+    const int max_steps = f_.max_steps;
+    const float eps = f_.eps;
+    run(
+        rs, [](Lanes&, int) {},
+        [&](Lanes& L, int m, const float* d) {
+            for (int i = 0; i < m; ++i) {
+                const float s = L.sg[i] * d[i];
+                const float thr = eps * std::max(L.t0[i] + L.t[i], 1.0f);
+                const int st = ++L.steps[i];
+                const bool stop = (s < thr) | (st >= max_steps);  // hit, or out of steps (decided in finish)
+                const float tn = L.t[i] + s;
+                const bool out = !(tn <= L.tmax[i]);  // also NaN
+                L.a[i] = s;
+                L.t[i] = stop ? L.t[i] : tn;
+                L.done[i] = stop | out;
+            }
+        },
+        [&](Lanes& L, int i) {
+            const uint32_t r = L.ray[i];
+            const float s = L.a[i], path = L.t0[i] + L.t[i];
+            t_[r] = L.t[i];
+            steps_[r] = L.steps[i];
+            hit_[r] = s < f_.thr(path) || (L.steps[i] >= max_steps && s < f_.footprint(path));
+        },
+        [&](uint32_t r) { t_[r] = rs.tmax[r]; });
+}
+
+// Cone tracing of primary rays: fills ev_* (partial hits), t_/hit_ (final hit), trans_
+// (weight left for the final hit or the background) and steps_.
+void Worker::cone_march(const RaySet& rs) {
+    const size_t n = rs.size();
+    t_.resize(n);
+    hit_.assign(n, 0);
+    steps_.assign(n, 0);
+    ev_n_.assign(n, 0);
+    ev_t_.resize(n * kConeEvents);
+    ev_w_.resize(n * kConeEvents);
+    trans_.assign(n, 1.0f);
+    const int max_steps = f_.max_steps;
+    auto emit = [&](uint32_t r, float t, float coverage) {
+        int& k = ev_n_[r];
+        if (k >= kConeEvents || !(coverage > 0.0f)) return;
+        ev_t_[r * kConeEvents + k] = t;
+        ev_w_[r * kConeEvents + k] = trans_[r] * coverage;
+        trans_[r] *= 1.0f - coverage;
+        ++k;
+    };
+    // Lane state: a = smallest d / r in the current edge zone (>= 1: none), b = its t,
+    // w = 1 when the final state is a hit.
+    run(
+        rs, [](Lanes& L, int i) { L.a[i] = 2.0f; },
+        [&](Lanes& L, int m, const float* dist) {
+            for (int i = 0; i < m; ++i) {
+                const uint32_t r = L.ray[i];
+                const float d = dist[i], t = L.t[i], path = L.t0[i] + t;
+                const float radius = std::max(f_.footprint(path), 1e-30f);
+                const int st = ++L.steps[i];
+                bool done = false, hit = false;
+                if (d < f_.thr(path)) {
+                    done = hit = true;  // the axis hits: this surface takes the remaining weight
+                } else if (!(d == d)) {
+                    done = true;
+                } else {
+                    const float rho = d / radius;
+                    if (rho < 1.0f) {
+                        if (rho < L.a[i]) L.a[i] = rho, L.b[i] = t;
+                    } else if (L.a[i] < 1.0f) {
+                        emit(r, L.b[i], 1.0f - L.a[i]);  // left an edge zone: composite its closest approach
+                        L.a[i] = 2.0f;
+                    }
+                    if (trans_[r] < 1e-3f) {
+                        done = true;  // fully covered by edges
+                    } else if (st >= max_steps) {
+                        done = true;
+                        hit = d < radius;
+                    } else {
+                        L.t[i] = t + d;
+                        done = !(L.t[i] <= L.tmax[i]);
+                    }
+                    if (done && !hit && L.a[i] < 1.0f) emit(r, L.b[i], 1.0f - L.a[i]);
+                }
+                L.w[i] = hit ? 1.0f : 0.0f;
+                L.done[i] = done;
+            }
+        },
+        [&](Lanes& L, int i) {
+            const uint32_t r = L.ray[i];
+            t_[r] = L.t[i];
+            hit_[r] = L.w[i] > 0.0f;
+            steps_[r] = L.steps[i];
+        },
+        [&](uint32_t r) { t_[r] = rs.tmax[r]; });
+}
+
+void Worker::compute_normals(const RaySet& h) {
+    static constexpr float kx[4] = {1, -1, -1, 1}, ky[4] = {-1, -1, 1, 1}, kz[4] = {-1, 1, -1, 1};
+    const size_t n = h.size();
+    px_.resize(n * 4), py_.resize(n * 4), pz_.resize(n * 4), pd_.resize(n * 4);
+    for (size_t i = 0; i < n; ++i) {
+        const glm::vec3 p = h.o(i);
+        const float e = std::max(f_.thr(h.t0[i]), 2e-5f * (1.0f + maxabs3(p)));
+        for (int k = 0; k < 4; ++k) {
+            px_[i * 4 + k] = p.x + e * kx[k];
+            py_[i * 4 + k] = p.y + e * ky[k];
+            pz_[i * 4 + k] = p.z + e * kz[k];
+        }
+    }
+    eval_points(px_.data(), py_.data(), pz_.data(), n * 4, pd_.data());
+    nx_.resize(n), ny_.resize(n), nz_.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+        const float* d = &pd_[i * 4];
+        glm::vec3 g(d[0] * kx[0] + d[1] * kx[1] + d[2] * kx[2] + d[3] * kx[3],
+                    d[0] * ky[0] + d[1] * ky[1] + d[2] * ky[2] + d[3] * ky[3],
+                    d[0] * kz[0] + d[1] * kz[1] + d[2] * kz[2] + d[3] * kz[3]);
+        const float len2 = glm::dot(g, g);
+        if (len2 > 1e-30f && std::isfinite(len2)) g *= 1.0f / std::sqrt(len2);
+        else g = -h.d(i);  // flat or broken field: face the viewer
+        nx_[i] = g.x, ny_[i] = g.y, nz_[i] = g.z;
+    }
+}
+
+// Material channels at the hit points, sanitised (no NaN/inf, sensible ranges).
+void Worker::compute_materials(const RaySet& h) {
+    const size_t n = h.size();
+    mat_.resize(n * kMatOut);
+    for (size_t i0 = 0; i0 < n; i0 += kBatch) {
+        const int m = static_cast<int>(std::min<size_t>(kBatch, n - i0));
+        if (shade_) {
+            shade_->eval(h.ox.data() + i0, h.oy.data() + i0, h.oz.data() + i0, m, f_.time);
+            stats.shading_points += static_cast<uint64_t>(m);
+            for (int c = 0; c < kMatOut; ++c) {
+                const float* o = shade_->output(c + 1);
+                for (int i = 0; i < m; ++i) mat_[(i0 + i) * kMatOut + c] = o[i];
+            }
+        } else {
+            for (int i = 0; i < m; ++i) {
+                float* q = &mat_[(i0 + i) * kMatOut];
+                std::fill_n(q, kMatOut, 0.0f);
+                q[kMatR] = q[kMatG] = q[kMatB] = 0.8f;
+                q[kMatSpecular] = 0.5f, q[kMatShininess] = 32.0f, q[kMatIor] = 1.5f;
+            }
+        }
+    }
+    for (size_t i = 0; i < n; ++i) {
+        float* q = &mat_[i * kMatOut];
+        for (int c : {kMatR, kMatG, kMatB, kMatSpecular, kMatEmitR, kMatEmitG, kMatEmitB}) q[c] = nonneg(q[c]);
+        q[kMatShininess] = std::isfinite(q[kMatShininess]) ? std::clamp(q[kMatShininess], 0.0f, 1e4f) : 32.0f;
+        q[kMatReflect] = clamp01(q[kMatReflect]);
+        q[kMatTransparency] = clamp01(q[kMatTransparency]);
+        q[kMatIor] = (std::isfinite(q[kMatIor]) && q[kMatIor] > 1e-3f) ? q[kMatIor] : 1.5f;
+    }
+}
+
+// Hard shadows: vis_[i] = 0 if the segment hits anything, else 1.
+void Worker::shadow_hard(const RaySet& rs) {
+    vis_.assign(rs.size(), 1.0f);
+    const int max_steps = f_.max_steps;
+    const float eps = f_.eps;
+    run(
+        rs, [](Lanes&, int) {},
+        [&](Lanes& L, int m, const float* d) {
+            for (int i = 0; i < m; ++i) {
+                const float thr = eps * std::max(L.t0[i] + L.t[i], 1.0f);
+                const int st = ++L.steps[i];
+                const bool stop = (d[i] < thr) | (st >= max_steps);
+                const float tn = L.t[i] + d[i];
+                const bool out = !(tn < L.tmax[i]);  // also NaN: no occluder found
+                L.a[i] = d[i];
+                L.t[i] = stop ? L.t[i] : tn;
+                L.done[i] = stop | out;
+            }
+        },
+        [&](Lanes& L, int i) {
+            const float d = L.a[i], path = L.t0[i] + L.t[i];
+            const bool blocked = d < f_.thr(path) || (L.steps[i] >= max_steps && d < f_.footprint(path));
+            vis_[L.ray[i]] = blocked ? 0.0f : 1.0f;
+        },
+        [](uint32_t) {});
+}
+
+// Soft shadows; sw_[i] is the light's angular width (tangent) seen from ray i.
+// Lane state: a = res (the smallest cone fraction), b = the previous positive distance.
+void Worker::shadow_soft(const RaySet& rs) {
+    vis_.assign(rs.size(), 1.0f);
+    const int max_steps = f_.max_steps;
+    const float eps = f_.eps;
+    run(
+        rs,
+        [&](Lanes& L, int i) {
+            L.w[i] = sw_[L.ray[i]];
+            L.a[i] = 1.0f;
+            L.b[i] = 1e20f;
+        },
+        [&](Lanes& L, int m, const float* dist) {
+            for (int i = 0; i < m; ++i) {
+                const float h = dist[i], t = L.t[i], w = L.w[i];
+                const float thr = eps * std::max(L.t0[i] + t, 1.0f);
+                const bool pos = h > 0.0f;
+                // Closest approach between this sample and the previous one (Quilez 2018);
+                // inside an occluder, the (negative) depth relative to the cone.
+                const float y = std::min(h * h / (2.0f * L.b[i]), 0.999f * h);
+                const float dd = std::sqrt(std::max(h * h - y * y, 0.0f));
+                const float est = pos ? dd / (w * std::max(t - y, 1e-20f)) : h / (w * std::max(t, 1e-20f));
+                const float res = est < L.a[i] ? est : L.a[i];  // NaN keeps res
+                L.a[i] = res;
+                L.b[i] = pos ? h : 1e20f;
+                // Sphere tracing outside; through an occluder in steps of a quarter cone width.
+                const float step = pos ? std::max(h, thr) : std::max(0.25f * w * t, thr);
+                const float tn = t + step;
+                L.t[i] = tn;
+                const int st = ++L.steps[i];
+                L.done[i] = (h != h) | (res <= -1.0f) | (st >= max_steps) | !(tn < L.tmax[i]);
+            }
+        },
+        [&](Lanes& L, int i) {
+            const float res = std::clamp(L.a[i], -1.0f, 1.0f);
+            vis_[L.ray[i]] = 0.25f * (1.0f + res) * (1.0f + res) * (2.0f - res);
+        },
+        [](uint32_t) {});
+}
+
+// Shades a set of hit points of generation `gen`, adding to accum_ and spawning `next`.
+void Worker::shade(const RaySet& h, int gen, RaySet& next) {
+    const size_t n = h.size();
+    if (n == 0) return;
+    compute_normals(h);
+    const bool need_shading = f_.view == RenderView::Shaded;
+    if (gen == 0 && f_.want_normal) {
+        for (size_t i = 0; i < n; ++i) {
+            const uint32_t p = h.prim[i];
+            if (h.wr[i] + h.wg[i] + h.wb[i] >= prim_aw_[p]) {
+                prim_n_[p * 3 + 0] = nx_[i], prim_n_[p * 3 + 1] = ny_[i], prim_n_[p * 3 + 2] = nz_[i];
+            }
+        }
+    }
+    if (!need_shading) return;
+    compute_materials(h);
+
+    const bool can_spawn = gen < f_.max_bounces;
+    const float min_w = kMinWeight / static_cast<float>(f_.samples);
+    local_.clear(), lw_.clear(), lnx_.clear(), lny_.clear(), lnz_.clear();
+    for (size_t i = 0; i < n; ++i) {
+        const glm::vec3 P = h.o(i), D = h.d(i), W = h.w(i);
+        const glm::vec3 N(nx_[i], ny_[i], nz_[i]);
+        const glm::vec3 Nf = glm::dot(D, N) > 0.0f ? -N : N;  // facing the incoming ray
+        const float* m = &mat_[i * kMatOut];
+        const float ior = m[kMatIor];
+        const float bias = f_.bias(P, h.t0[i]);
+        if (h.inside[i]) {
+            // Leaving a transparent solid: refract out, reflect back in (Fresnel / TIR).
+            if (!can_spawn) continue;
+            const glm::vec3 T = glm::refract(D, Nf, ior);
+            float F = 1.0f;
+            if (glm::dot(T, T) > 0.0f) F = schlick(-glm::dot(T, Nf), ior);
+            const glm::vec3 wr = W * F, wt = W * (1.0f - F);
+            if (max3(wr) >= min_w) push_secondary(next, P + Nf * bias, glm::reflect(D, Nf), h.t0[i], wr, h.prim[i], true);
+            if (max3(wt) >= min_w) push_secondary(next, P - Nf * bias, glm::normalize(T), h.t0[i], wt, h.prim[i], false);
+            continue;
+        }
+        add(h.prim[i], W * glm::vec3(m[kMatEmitR], m[kMatEmitG], m[kMatEmitB]));
+        const float refl = can_spawn ? m[kMatReflect] : 0.0f;
+        const float tr = can_spawn ? m[kMatTransparency] : 0.0f;
+        const glm::vec3 lw = W * ((1.0f - refl) * (1.0f - tr));
+        if (max3(lw) > 0.0f) {
+            local_.push_back(static_cast<uint32_t>(i));
+            lw_.insert(lw_.end(), {lw.x, lw.y, lw.z});
+            lnx_.push_back(Nf.x), lny_.push_back(Nf.y), lnz_.push_back(Nf.z);
+        }
+        if (!can_spawn) continue;
+        glm::vec3 w_refl = W * refl;
+        if (tr > 0.0f) {
+            const glm::vec3 base = W * ((1.0f - refl) * tr);
+            const glm::vec3 T = glm::refract(D, Nf, 1.0f / ior);
+            float F = 1.0f;
+            if (glm::dot(T, T) > 0.0f) F = schlick(-glm::dot(D, Nf), ior);
+            w_refl += base * F;
+            const glm::vec3 wt = base * (1.0f - F) * glm::vec3(m[kMatR], m[kMatG], m[kMatB]);
+            if (max3(wt) >= min_w) push_secondary(next, P - Nf * bias, glm::normalize(T), h.t0[i], wt, h.prim[i], true);
+        }
+        if (max3(w_refl) >= min_w) push_secondary(next, P + Nf * bias, glm::reflect(D, Nf), h.t0[i], w_refl, h.prim[i], false);
+    }
+
+    const size_t nl = local_.size();
+    if (nl == 0) return;
+
+    // Ambient (with occlusion).
+    const glm::vec3 amb = f_.ambient;
+    if (max3(amb) > 0.0f) {
+        ao_.assign(nl, 1.0f);
+        if (f_.ao) {
+            px_.resize(nl * kAoTaps), py_.resize(nl * kAoTaps), pz_.resize(nl * kAoTaps), pd_.resize(nl * kAoTaps);
+            for (size_t k = 0; k < nl; ++k) {
+                const glm::vec3 P = h.o(local_[k]);
+                for (int j = 0; j < kAoTaps; ++j) {
+                    const float s = 0.01f + 0.12f * static_cast<float>(j) / (kAoTaps - 1);
+                    px_[k * kAoTaps + j] = P.x + lnx_[k] * s;
+                    py_[k * kAoTaps + j] = P.y + lny_[k] * s;
+                    pz_[k * kAoTaps + j] = P.z + lnz_[k] * s;
+                }
+            }
+            eval_points(px_.data(), py_.data(), pz_.data(), nl * kAoTaps, pd_.data());
+            for (size_t k = 0; k < nl; ++k) {
+                float occ = 0.0f, sca = 1.0f;
+                for (int j = 0; j < kAoTaps; ++j) {
+                    const float s = 0.01f + 0.12f * static_cast<float>(j) / (kAoTaps - 1);
+                    const float d = pd_[k * kAoTaps + j];
+                    if (d == d) occ += (s - std::min(d, s + 1.0f)) * sca;
+                    sca *= 0.95f;
+                }
+                ao_[k] = clamp01(1.0f - 3.0f * occ);
+            }
+        }
+        for (size_t k = 0; k < nl; ++k) {
+            const float* m = &mat_[local_[k] * kMatOut];
+            const glm::vec3 lw(lw_[k * 3], lw_[k * 3 + 1], lw_[k * 3 + 2]);
+            add(h.prim[local_[k]], lw * glm::vec3(m[kMatR], m[kMatG], m[kMatB]) * amb * ao_[k]);
+        }
+    }
+
+    // Direct light, one batched shadow pass per light.
+    for (const ResolvedLight& light : f_.scene->lights) {
+        const glm::vec3 radiance = light.color * light.intensity;
+        if (!(max3(radiance) > 0.0f) || !std::isfinite(max3(radiance))) continue;
+        glm::vec3 ldir = -light.direction;
+        if (light.directional) {
+            if (!(glm::dot(ldir, ldir) > 0.0f)) continue;
+            ldir = glm::normalize(ldir);
+        }
+        shadow_.clear(), sh_idx_.clear(), sw_.clear(), lrad_.clear();
+        for (size_t k = 0; k < nl; ++k) {
+            const uint32_t i = local_[k];
+            const glm::vec3 P = h.o(i), N(lnx_[k], lny_[k], lnz_[k]);
+            glm::vec3 L = ldir;
+            float dist = f_.max_dist, falloff = 1.0f;
+            if (!light.directional) {
+                L = light.position - P;
+                dist = glm::length(L);
+                if (!(dist > 1e-6f)) continue;
+                L /= dist;
+                falloff = 1.0f / (dist * dist);
+            }
+            const float ndl = glm::dot(N, L);
+            if (!(ndl > 0.0f)) continue;
+            const glm::vec3 V = -h.d(i);
+            const glm::vec3 Hv = glm::normalize(L + V);
+            const float* m = &mat_[i * kMatOut];
+            const float ndh = std::max(glm::dot(N, Hv), 0.0f);
+            const float spec = m[kMatSpecular] > 0.0f ? m[kMatSpecular] * std::pow(ndh, m[kMatShininess]) : 0.0f;
+            const glm::vec3 lw(lw_[k * 3], lw_[k * 3 + 1], lw_[k * 3 + 2]);
+            const glm::vec3 c = lw * radiance * falloff * (glm::vec3(m[kMatR], m[kMatG], m[kMatB]) * ndl + spec);
+            if (!f_.shadows) {
+                add(h.prim[i], c);
+                continue;
+            }
+            const float bias = f_.bias(P, h.t0[i]);
+            const glm::vec3 o = P + N * bias;
+            float tmin = 0.0f, tmax = light.directional ? f_.max_dist : std::max(dist - bias, 0.0f);
+            f_.clip_ray(o, L, tmin, tmax);
+            if (!(tmin <= tmax)) {
+                add(h.prim[i], c);  // the segment never enters the scene's bounds
+                continue;
+            }
+            shadow_.push(o, L, tmin, tmax, h.t0[i], glm::vec3(0), h.prim[i], false);
+            sh_idx_.push_back(i);
+            lrad_.insert(lrad_.end(), {c.x, c.y, c.z});
+            sw_.push_back(light.directional ? light.radius : light.radius / dist);
+        }
+        if (shadow_.size() == 0) continue;
+        if (light.radius > 0.0f) shadow_soft(shadow_);
+        else shadow_hard(shadow_);
+        for (size_t s = 0; s < shadow_.size(); ++s)
+            if (vis_[s] > 0.0f) add(shadow_.prim[s], glm::vec3(lrad_[s * 3], lrad_[s * 3 + 1], lrad_[s * 3 + 2]) * vis_[s]);
+    }
+}
+
+void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* depth, AovPlane* normal, AovPlane* steps) {
+    const int tw = x1 - x0, th = y1 - y0;
+    const int S = f_.samples;
+    const size_t npix = static_cast<size_t>(tw) * th, nprim = npix * S;
+    accum_.assign(npix * 3, 0.0f);
+    prim_depth_.assign(nprim, f_.max_dist);
+    prim_steps_.assign(nprim, 0.0f);
+    prim_n_.assign(f_.want_normal ? nprim * 3 : 0, 0.0f);
+    prim_aw_.assign(nprim, -1.0f);
+    const float w0 = 1.0f / static_cast<float>(S);
+    const glm::vec3 bg = f_.background;
+
+    rays_.clear();
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            const uint32_t pix = static_cast<uint32_t>((y - y0) * tw + (x - x0));
+            for (int s = 0; s < S; ++s) {
+                const glm::vec2 o = f_.offsets[s];
+                push_primary(rays_, f_.camera.ray(static_cast<float>(x) + o.x, static_cast<float>(y) + o.y), w0, pix * S + s);
+            }
+        }
+    stats.primary_rays += nprim;
+
+    // Generation 0.
+    hits_.clear();
+    if (f_.has_distance) {
+        if (f_.cone) cone_march(rays_);
+        else march(rays_);
+    } else {
+        t_.assign(nprim, f_.max_dist), hit_.assign(nprim, 0), steps_.assign(nprim, 0), trans_.assign(nprim, 1.0f), ev_n_.assign(nprim, 0);
+    }
+    for (size_t r = 0; r < nprim; ++r) {
+        prim_steps_[r] = static_cast<float>(steps_[r]);
+        const glm::vec3 O = rays_.o(r), D = rays_.d(r);
+        float rest = w0;
+        if (f_.cone) {
+            for (int e = 0; e < ev_n_[r]; ++e) {
+                const float t = ev_t_[r * kConeEvents + e], w = ev_w_[r * kConeEvents + e] * w0;
+                hits_.push(O + D * t, D, 0, 0, t, glm::vec3(w), static_cast<uint32_t>(r), false);
+                if (w > prim_aw_[r]) prim_aw_[r] = w, prim_depth_[r] = t;
+            }
+            rest = trans_[r] * w0;
+        }
+        if (hit_[r]) {
+            hits_.push(O + D * t_[r], D, 0, 0, t_[r], glm::vec3(rest), static_cast<uint32_t>(r), false);
+            if (rest > prim_aw_[r]) prim_aw_[r] = rest, prim_depth_[r] = t_[r];
+        } else {
+            add(static_cast<uint32_t>(r), bg * rest);
+        }
+    }
+    if (f_.view == RenderView::Shaded || f_.want_normal) shade(hits_, 0, next_);
+
+    // Secondary generations (reflection / refraction), iteratively.
+    for (int gen = 1; gen <= f_.max_bounces && next_.size() > 0; ++gen) {
+        std::swap(rays_, next_);
+        next_.clear();
+        march(rays_);
+        hits_.clear();
+        for (size_t r = 0; r < rays_.size(); ++r) {
+            if (hit_[r]) {
+                hits_.push(rays_.o(r) + rays_.d(r) * t_[r], rays_.d(r), 0, 0, rays_.t0[r] + t_[r], rays_.w(r), rays_.prim[r],
+                           rays_.inside[r] != 0);
+            } else if (!rays_.inside[r]) {
+                add(rays_.prim[r], bg * rays_.w(r));
+            }
+        }
+        shade(hits_, gen, next_);
+    }
+    next_.clear();
+
+    // Resolve the tile.
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            const size_t p = static_cast<size_t>((y - y0) * tw + (x - x0));
+            const size_t o = static_cast<size_t>(y) * img.width + x;
+            float st = 0.0f, dmin = f_.max_dist;
+            glm::vec3 nsum(0.0f);
+            for (int s = 0; s < S; ++s) {
+                st += prim_steps_[p * S + s];
+                dmin = std::min(dmin, prim_depth_[p * S + s]);
+                if (f_.want_normal) nsum += glm::vec3(prim_n_[(p * S + s) * 3], prim_n_[(p * S + s) * 3 + 1], prim_n_[(p * S + s) * 3 + 2]);
+            }
+            st *= w0;
+            if (f_.view == RenderView::Steps) {
+                float rgb[3];
+                heat_color(st / static_cast<float>(std::max(f_.max_steps, 1)), rgb);
+                for (int c = 0; c < 3; ++c) img.pixels[o * 3 + c] = srgb_to_linear(rgb[c]);
+            } else {
+                for (int c = 0; c < 3; ++c) {
+                    const float v = accum_[p * 3 + c];
+                    img.pixels[o * 3 + c] = v >= 0.0f ? std::min(v, 1e30f) : 0.0f;  // never NaN or inf
+                }
+            }
+            if (depth) depth->data[o] = std::isfinite(dmin) ? dmin : f_.max_dist;
+            if (steps) steps->data[o] = st;
+            if (normal) {
+                const float len = glm::length(nsum);
+                const glm::vec3 nn = (len > 1e-20f && std::isfinite(len)) ? nsum / len : glm::vec3(0.0f);
+                for (int c = 0; c < 3; ++c) normal->data[o * 3 + c] = nn[c];
+            }
+        }
+}
+
+// The Prospero image of a 2D model: white inside (d < 0).
+void Worker::render_tile_2d(int x0, int y0, int x1, int y1, Image& img, AovPlane* depth) {
+    alignas(64) float x[kBatch], y[kBatch], z[kBatch] = {};
+    const float sx = img.width > 1 ? 2.0f / static_cast<float>(img.width - 1) : 0.0f;
+    const float sy = img.height > 1 ? 2.0f / static_cast<float>(img.height - 1) : 0.0f;
+    for (int row = y0; row < y1; ++row)
+        for (int c0 = x0; c0 < x1; c0 += kBatch) {
+            const int m = std::min(kBatch, x1 - c0);
+            for (int i = 0; i < m; ++i) {
+                x[i] = -1.0f + sx * static_cast<float>(c0 + i);
+                y[i] = 1.0f - sy * static_cast<float>(row);
+            }
+            float d[kBatch];
+            if (f_.has_distance) {
+                dist_.eval(x, y, z, m, f_.time);
+                stats.distance_points += static_cast<uint64_t>(m);
+                std::copy_n(dist_.output(0), m, d);
+            } else {
+                std::fill_n(d, m, 1.0f);
+            }
+            for (int i = 0; i < m; ++i) {
+                const size_t o = static_cast<size_t>(row) * img.width + c0 + i;
+                const float v = d[i] < 0.0f ? 1.0f : 0.0f;
+                for (int c = 0; c < 3; ++c) img.pixels[o * 3 + c] = v;
+                if (depth) depth->data[o] = std::isfinite(d[i]) ? d[i] : 0.0f;
+            }
+        }
+}
+
+}  // namespace
+
+Image render(const CompiledScene& scene, const RenderOptions& options, RenderStats* stats) {
+    Frame f(scene);
+    const RenderSettings& rs = scene.render;
+    f.width = std::max(rs.width, 1);
+    f.height = std::max(rs.height, 1);
+    f.cone = rs.aa == "cone";
+    f.samples = f.cone ? 1 : std::clamp(rs.samples, 1, 4096);
+    f.max_steps = std::max(rs.max_steps, 1);
+    f.max_bounces = std::clamp(rs.max_bounces, 0, 64);
+    f.eps = std::isfinite(rs.epsilon) && rs.epsilon > 0 ? rs.epsilon : 1e-4f;
+    f.max_dist = std::isfinite(rs.max_distance) && rs.max_distance > 0 ? rs.max_distance : 100.0f;
+    f.shadows = rs.shadows;
+    f.ao = rs.ao;
+    f.time = scene.time;
+    f.view = options.view;
+    f.ambient = glm::vec3(nonneg(scene.ambient.x), nonneg(scene.ambient.y), nonneg(scene.ambient.z));
+    f.background = glm::vec3(nonneg(scene.background.x), nonneg(scene.background.y), nonneg(scene.background.z));
+    f.has_distance = !scene.distance.outputs.empty();
+    f.has_material = scene.shading.outputs.size() >= static_cast<size_t>(1 + kMatOut);
+    if (scene.bounds.finite()) {
+        // A little slack so rays start outside the surface's tolerance band.
+        const glm::vec3 ext = scene.bounds.hi - scene.bounds.lo;
+        const glm::vec3 margin = glm::vec3(1e-3f * std::max(max3(ext), 0.0f) + 1e-3f);
+        f.lo = scene.bounds.lo - margin;
+        f.hi = scene.bounds.hi + margin;
+        f.clip = f.lo.x <= f.hi.x && f.lo.y <= f.hi.y && f.lo.z <= f.hi.z;
+    }
+    for (int i = 0; i < f.samples; ++i) {
+        const float sx = (static_cast<float>(i) + 0.5f) / static_cast<float>(f.samples);
+        float sy = radical_inverse2(static_cast<uint32_t>(i)) + 0.5f / static_cast<float>(f.samples);
+        if (sy >= 1.0f) sy -= 1.0f;
+        f.offsets.emplace_back(sx, sy);
+    }
+    // Tiles hold ~256+ primary rays so the 64-lane window stays full while rays finish.
+    f.tile = f.samples <= 2 ? 16 : (f.samples <= 8 ? 8 : 4);
+
+    Image img(f.width, f.height, 3);
+    AovPlane *depth = nullptr, *normal = nullptr, *steps = nullptr;
+    img.aovs.reserve(options.aovs.size());
+    for (const std::string& name : options.aovs) {
+        if (std::find(known_aovs().begin(), known_aovs().end(), name) == known_aovs().end())
+            throw std::invalid_argument("unknown AOV '" + name + "' (known: depth, normal, steps)");
+        if (img.aov(name)) continue;
+        const int ch = name == "normal" ? 3 : 1;
+        img.aovs.push_back(AovPlane{name, ch, std::vector<float>(static_cast<size_t>(f.width) * f.height * ch, 0.0f)});
+    }
+    for (auto& a : img.aovs) {
+        if (a.name == "depth") depth = &a;
+        if (a.name == "normal") normal = &a;
+        if (a.name == "steps") steps = &a;
+    }
+    f.want_depth = depth != nullptr;
+    f.want_normal = normal != nullptr;
+    f.want_steps = steps != nullptr;
+
+    const int tx = (f.width + f.tile - 1) / f.tile, ty = (f.height + f.tile - 1) / f.tile;
+    tbb::enumerable_thread_specific<std::unique_ptr<Worker>> workers;
+    auto body = [&](const tbb::blocked_range<int>& range) {
+        std::unique_ptr<Worker>& w = workers.local();
+        if (!w) w = std::make_unique<Worker>(f);
+        for (int t = range.begin(); t != range.end(); ++t) {
+            const int x0 = (t % tx) * f.tile, y0 = (t / tx) * f.tile;
+            const int x1 = std::min(x0 + f.tile, f.width), y1 = std::min(y0 + f.tile, f.height);
+            if (scene.is_2d) w->render_tile_2d(x0, y0, x1, y1, img, depth);
+            else w->render_tile(x0, y0, x1, y1, img, depth, normal, steps);
+        }
+    };
+    const int threads = options.threads > 0 ? options.threads : tbb::task_arena::automatic;
+    tbb::task_arena arena(threads);
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, tx * ty, 1), body); });
+
+    if (stats) {
+        *stats = RenderStats{};
+        for (auto& w : workers)
+            if (w) {
+                stats->distance_points += w->stats.distance_points;
+                stats->shading_points += w->stats.shading_points;
+                stats->primary_rays += w->stats.primary_rays;
+            }
+    }
+    return img;
+}
+
+}  // namespace sdfc

@@ -1,0 +1,803 @@
+// The parser: grammar sanity, the snippets of LANGUAGE.md, precedence, lexical details,
+// locations, syntax errors (exact text and position) and the nesting limit.
+#include <catch2/catch.hpp>
+
+#include <fmt/format.h>
+
+#include "grammar/sdf_grammar.hpp"
+#include "lang/ast.hpp"
+
+#include <tao/pegtl/contrib/analyze.hpp>
+
+using namespace sdfc;
+using namespace sdfc::ast;
+
+namespace {
+
+struct Parsed {
+    std::unique_ptr<SourceFile> file;
+    std::unique_ptr<Module> module;
+    const Stmt& stmt(size_t i) const { return *module->stmts.at(i); }
+    size_t size() const { return module->stmts.size(); }
+};
+
+Parsed parse_text(const std::string& text, const ParseOptions& opts = {}) {
+    Parsed p;
+    p.file = std::make_unique<SourceFile>("test.sdf", text);
+    p.module = parse(*p.file, opts);
+    return p;
+}
+
+// The first diagnostic of a failing parse, as "line:col: message".
+std::string error_of(const std::string& text, const ParseOptions& opts = {}) {
+    SourceFile f("test.sdf", text);
+    try {
+        parse(f, opts);
+    } catch (const CompileError& e) {
+        const Diagnostic& d = e.diagnostics().at(0);
+        return fmt::format("{}:{}: {}", d.loc.line, d.loc.col, d.message);
+    }
+    return "no error";
+}
+
+const char* op_name(BinOp op) {
+    switch (op) {
+        case BinOp::Or: return "||";
+        case BinOp::And: return "&&";
+        case BinOp::Eq: return "==";
+        case BinOp::Ne: return "!=";
+        case BinOp::Lt: return "<";
+        case BinOp::Le: return "<=";
+        case BinOp::Gt: return ">";
+        case BinOp::Ge: return ">=";
+        case BinOp::Add: return "+";
+        case BinOp::Sub: return "-";
+        case BinOp::Mul: return "*";
+        case BinOp::Div: return "/";
+        case BinOp::Mod: return "%";
+    }
+    return "?";
+}
+
+std::string sx(const Expr* e);
+std::string sx_stmt(const Stmt* s);
+
+std::string sx_args(const std::vector<Arg>& args) {
+    std::string out;
+    for (const auto& a : args) out += " " + (a.name.empty() ? "" : a.name + "=") + sx(a.value.get());
+    return out;
+}
+
+std::string sx_block(const Block& b) {
+    std::string out = "{";
+    for (const auto& s : b.stmts) out += sx_stmt(s.get()) + "; ";
+    if (b.result) out += "=> " + sx(b.result.get());
+    return out + "}";
+}
+
+std::string sx_bindings(const std::vector<ForBinding>& bs) {
+    std::string out;
+    for (const auto& b : bs) out += fmt::format("({} {})", b.name, sx(b.iterable.get()));
+    return out;
+}
+
+// A compact s-expression of an expression, to check structure.
+std::string sx(const Expr* e) {
+    if (!e) return "null";
+    switch (e->kind) {
+        case ExprKind::Number: return fmt::format("{}", e->number);
+        case ExprKind::Bool: return e->boolean ? "true" : "false";
+        case ExprKind::String: return "\"" + e->text + "\"";
+        case ExprKind::Ident: return e->text;
+        case ExprKind::Vector: {
+            std::string out = "[";
+            for (size_t i = 0; i < e->elems.size(); ++i) out += (i ? " " : "") + sx(e->elems[i].get());
+            return out + "]";
+        }
+        case ExprKind::Range:
+            return e->elems[1] ? fmt::format("(range {} {} {})", sx(e->elems[0].get()), sx(e->elems[1].get()),
+                                             sx(e->elems[2].get()))
+                               : fmt::format("(range {} {})", sx(e->elems[0].get()), sx(e->elems[2].get()));
+        case ExprKind::Unary: return fmt::format("({} {})", e->un_op == UnOp::Neg ? "neg" : "not", sx(e->lhs.get()));
+        case ExprKind::Binary: return fmt::format("({} {} {})", op_name(e->bin_op), sx(e->lhs.get()), sx(e->rhs.get()));
+        case ExprKind::Ternary:
+            return fmt::format("(? {} {} {})", sx(e->elems[0].get()), sx(e->elems[1].get()), sx(e->elems[2].get()));
+        case ExprKind::Call: return fmt::format("(call {}{})", sx(e->callee.get()), sx_args(e->args));
+        case ExprKind::Index: return fmt::format("(index {} {})", sx(e->lhs.get()), sx(e->rhs.get()));
+        case ExprKind::Swizzle: return fmt::format("(.{} {})", e->text, sx(e->lhs.get()));
+        case ExprKind::Apply: return fmt::format("(apply {} {})", sx(e->lhs.get()), sx(e->rhs.get()));
+        case ExprKind::BlockExpr: return sx_block(*e->block);
+        case ExprKind::Field: return fmt::format("(field{} ({}) {})", sx_args(e->args), e->text, sx(e->body.get()));
+        case ExprKind::If:
+            return e->elems[2] ? fmt::format("(if {} {} {})", sx(e->elems[0].get()), sx(e->elems[1].get()),
+                                             sx(e->elems[2].get()))
+                               : fmt::format("(if {} {})", sx(e->elems[0].get()), sx(e->elems[1].get()));
+        case ExprKind::For: return fmt::format("(for {} {})", sx_bindings(e->bindings), sx(e->body.get()));
+    }
+    return "?";
+}
+
+std::string sx_stmt(const Stmt* s) {
+    switch (s->kind) {
+        case StmtKind::Let: return fmt::format("let {} = {}", s->name, sx(s->value.get()));
+        case StmtKind::Var: return fmt::format("var {} = {}", s->name, sx(s->value.get()));
+        case StmtKind::Assign: return fmt::format("{} = {}", s->name, sx(s->value.get()));
+        case StmtKind::Def: {
+            std::string ps;
+            for (const auto& p : s->params)
+                ps += (ps.empty() ? "" : ", ") + p.name + (p.default_value ? " = " + sx(p.default_value.get()) : "");
+            return fmt::format("def {}({}) = {}", s->name, ps, sx(s->value.get()));
+        }
+        case StmtKind::Import: return fmt::format("import \"{}\"", s->name);
+        case StmtKind::Expr: return sx(s->value.get());
+        case StmtKind::If:
+            return s->else_branch ? fmt::format("if {} then {} else {}", sx(s->value.get()), sx_stmt(s->then_branch.get()),
+                                                sx_stmt(s->else_branch.get()))
+                                  : fmt::format("if {} then {}", sx(s->value.get()), sx_stmt(s->then_branch.get()));
+        case StmtKind::For: return fmt::format("for {} {}", sx_bindings(s->bindings), sx_stmt(s->body.get()));
+        case StmtKind::Empty: return "empty";
+    }
+    return "?";
+}
+
+// The s-expression of a one-statement script.
+std::string sx1(const std::string& text) {
+    Parsed p = parse_text(text);
+    REQUIRE(p.size() == 1);
+    return sx_stmt(&p.stmt(0));
+}
+
+// An expression in a statement of its own.
+std::string ex(const std::string& expr) { return sx1("x = " + expr + ";").substr(4); }
+
+}  // namespace
+
+// --------------------------------------------------------------------------------- grammar
+
+TEST_CASE("the grammar has no PEG problems (analyze)", "[parser]") {
+    CHECK(tao::pegtl::analyze<sdfc::grammar::grammar>(1) == 0);
+}
+
+namespace broken {
+using namespace tao::pegtl;
+struct left_rec;
+struct left_rec : seq<opt<one<'x'>>, left_rec, one<'y'>> {};  // may recurse without consuming
+struct empty_loop : star<opt<one<'z'>>> {};                   // a loop that may not progress
+}  // namespace broken
+
+TEST_CASE("analyze detects a deliberately broken grammar", "[parser]") {
+    CHECK(tao::pegtl::analyze<broken::left_rec>(-1) > 0);  // -1: quiet
+    CHECK(tao::pegtl::analyze<broken::empty_loop>(-1) > 0);
+}
+
+// ------------------------------------------------------------------------ LANGUAGE.md
+
+TEST_CASE("section 1: a first script", "[parser]") {
+    Parsed p = parse_text(R"(// three-tori.sdf — a sphere "terrain", three tori, two point lights
+camera(position = [0, 3, 9], target = [0, 1, 0], fov = 40);
+light(position = [ 5, 8,  4], color = [1.0, 0.9, 0.8], intensity = 60);
+light(position = [-6, 5, -2], color = [0.4, 0.5, 1.0], intensity = 30);
+render(width = 800, height = 450, samples = 4, max_steps = 256, epsilon = 1e-4);
+
+let gold = material(color = [0.9, 0.7, 0.2], specular = 0.6, shininess = 64);
+
+translate([0, -100, 0]) sphere(100);                 // the terrain
+for (i = [0 : 2])
+    translate([(i - 1) * 2.5, 1, 0]) rotate(x = 90 + 30 * i)
+        material(gold) torus(0.8, 0.25);
+)");
+    REQUIRE(p.size() == 7);
+    CHECK(sx_stmt(&p.stmt(0)) == "(call camera position=[0 3 9] target=[0 1 0] fov=40)");
+    CHECK(sx_stmt(&p.stmt(2)) == "(call light position=[(neg 6) 5 (neg 2)] color=[0.4 0.5 1] intensity=30)");
+    CHECK(sx_stmt(&p.stmt(3)) ==
+          "(call render width=800 height=450 samples=4 max_steps=256 epsilon=0.0001)");
+    CHECK(p.stmt(4).kind == StmtKind::Let);
+    CHECK(p.stmt(4).name == "gold");
+    CHECK(sx_stmt(&p.stmt(5)) == "(apply (call translate [0 (neg 100) 0]) (call sphere 100))");
+    const Stmt& f = p.stmt(6);
+    REQUIRE(f.kind == StmtKind::For);
+    REQUIRE(f.bindings.size() == 1);
+    CHECK(f.bindings[0].name == "i");
+    CHECK(sx(f.bindings[0].iterable.get()) == "(range 0 2)");
+    CHECK(sx_stmt(f.body.get()) ==
+          "(apply (call translate [(* (- i 1) 2.5) 1 0]) (apply (call rotate x=(+ 90 (* 30 i))) "
+          "(apply (call material gold) (call torus 0.8 0.25))))");
+    // Locations.
+    CHECK(p.stmt(0).loc.line == 2);
+    CHECK(p.stmt(0).loc.col == 1);
+    CHECK(p.stmt(4).name_loc.line == 7);
+    CHECK(p.stmt(4).name_loc.col == 5);
+    CHECK(f.loc.line == 10);
+    CHECK(f.body->loc.line == 11);
+    CHECK(f.body->loc.col == 5);
+    CHECK(f.bindings[0].loc.col == 6);
+}
+
+TEST_CASE("section 4: definitions and control", "[parser]") {
+    Parsed p = parse_text(R"(let r = 0.5;                                   // constant binding (file or block scope)
+def ring(R, t = 0.1) = rotate(x = 90) torus(R, t);       // function returning a shape
+def lerp3(a, b, k) = a + (b - a) * k;                   // function returning a value
+import "lib/furniture.sdf";                    // definitions of another file, path relative to this one
+if (r > 0.3) sphere(r); else box(r);           // statement-level conditional
+for (i = [0 : 7]) rotate(y = 45 * i) translate([2, 0, 0]) sphere(0.2);   // union of the iterations
+for (x = [0 : 2], z = [0 : 2]) translate([x, 0, z]) box(0.4);             // nested loop
+for (s = [-1, 1]) translate([s, 0, 0]) sphere(1);
+let c = cylinder(2, 1); c;
+def pair() = { sphere(1); box(1); };
+k > 0 ? sphere(1) : { box(1); sphere(2); };
+)");
+    REQUIRE(p.size() == 12);
+    CHECK(sx_stmt(&p.stmt(0)) == "let r = 0.5");
+    CHECK(sx_stmt(&p.stmt(1)) == "def ring(R, t = 0.1) = (apply (call rotate x=90) (call torus R t))");
+    CHECK(sx_stmt(&p.stmt(2)) == "def lerp3(a, b, k) = (+ a (* (- b a) k))");
+    CHECK(p.stmt(3).kind == StmtKind::Import);
+    CHECK(p.stmt(3).name == "lib/furniture.sdf");
+    CHECK(p.stmt(3).name_loc.col == 8);
+    CHECK(sx_stmt(&p.stmt(4)) == "if (> r 0.3) then (call sphere r) else (call box r)");
+    CHECK(sx_stmt(&p.stmt(5)) ==
+          "for (i (range 0 7)) (apply (call rotate y=(* 45 i)) (apply (call translate [2 0 0]) (call sphere 0.2)))");
+    CHECK(sx_stmt(&p.stmt(6)) == "for (x (range 0 2))(z (range 0 2)) (apply (call translate [x 0 z]) (call box 0.4))");
+    CHECK(sx_stmt(&p.stmt(7)) == "for (s [(neg 1) 1]) (apply (call translate [s 0 0]) (call sphere 1))");
+    CHECK(sx_stmt(&p.stmt(9)) == "c");
+    CHECK(sx_stmt(&p.stmt(10)) == "def pair() = {(call sphere 1); (call box 1); }");
+    CHECK(sx_stmt(&p.stmt(11)) == "(? (> k 0) (call sphere 1) {(call box 1); (call sphere 2); })");
+    // Def parameters and their locations.
+    const Stmt& ring = p.stmt(1);
+    REQUIRE(ring.params.size() == 2);
+    CHECK(ring.name_loc.col == 5);
+    CHECK(ring.params[1].loc.col == 13);
+    CHECK(ring.params[0].default_value == nullptr);
+}
+
+TEST_CASE("section 6: operations", "[parser]") {
+    CHECK(sx1("translate([1,0,0]) rotate(y = 30) box(1);") ==
+          "(apply (call translate [1 0 0]) (apply (call rotate y=30) (call box 1)))");
+    CHECK(sx1("union { a; b; }") == "(apply union {a; b; })");
+    CHECK(sx1("difference { box(1); sphere(0.6); }") == "(apply difference {(call box 1); (call sphere 0.6); })");
+    CHECK(sx1("smooth_union(0.3) { sphere(1); translate([1, 0, 0]) box(1); }") ==
+          "(apply (call smooth_union 0.3) {(call sphere 1); (apply (call translate [1 0 0]) (call box 1)); })");
+    CHECK(sx1("stairs_union(0.2, 4) { a; b; }") == "(apply (call stairs_union 0.2 4) {a; b; })");
+    CHECK(sx1("material(color = [1, 0, 0]) sphere(1);") == "(apply (call material color=[1 0 0]) (call sphere 1))");
+    CHECK(sx1("repeat([2, 0, 2], 3) round(0.1) box(1);") ==
+          "(apply (call repeat [2 0 2] 3) (apply (call round 0.1) (call box 1)))");
+    CHECK(sx1("rotate(angle = 45, axis = [0, 1, 0]) symmetry(x = true) sphere(1);") ==
+          "(apply (call rotate angle=45 axis=[0 1 0]) (apply (call symmetry x=true) (call sphere 1)))");
+    CHECK(sx1("let m = material(color = [r, g, b], specular = 0.5, shininess = 32, reflect = 0, transparency = 0, "
+              "ior = 1.5, emission = [0,0,0]);")
+              .rfind("let m = (call material color=[r g b]", 0) == 0);
+}
+
+TEST_CASE("section 7: custom distance fields", "[parser]") {
+    Parsed p = parse_text(R"(def hollow(s, w) = field (p) -> max(s(p), -(s(p) + w));
+def menger(n) = field (p) -> {
+    var d = box(2)(p);
+    var s = 1;
+    for (m = [1 : n]) {                   // unrolled at compile time
+        let a = mod(p * s, 2) - 1;
+        s = s * 3;
+        let r = abs(1 - 3 * abs(a));
+        let c = (min(max(r.x, r.y), min(max(r.y, r.z), max(r.z, r.x))) - 1) / s;
+        d = max(d, c);
+    }
+    d
+};
+menger(4);
+)");
+    REQUIRE(p.size() == 3);
+    CHECK(sx_stmt(&p.stmt(0)) == "def hollow(s, w) = (field (p) (call max (call s p) (neg (+ (call s p) w))))");
+    const Stmt& m = p.stmt(1);
+    REQUIRE(m.kind == StmtKind::Def);
+    const Expr& field = *m.value;
+    REQUIRE(field.kind == ExprKind::Field);
+    CHECK(field.text == "p");
+    CHECK(field.args.empty());
+    REQUIRE(field.body->kind == ExprKind::BlockExpr);
+    const Block& b = *field.body->block;
+    REQUIRE(b.stmts.size() == 3);
+    CHECK(sx_stmt(b.stmts[0].get()) == "var d = (call (call box 2) p)");
+    CHECK(b.stmts[1]->kind == StmtKind::Var);
+    const Stmt& loop = *b.stmts[2];
+    REQUIRE(loop.kind == StmtKind::For);
+    CHECK(sx(loop.bindings[0].iterable.get()) == "(range 1 n)");
+    REQUIRE(loop.body->kind == StmtKind::Expr);
+    const Block& inner = *loop.body->value->block;
+    REQUIRE(inner.stmts.size() == 5);
+    CHECK(inner.result == nullptr);
+    CHECK(sx_stmt(inner.stmts[1].get()) == "s = (* s 3)");
+    CHECK(sx_stmt(inner.stmts[3].get()) ==
+          "let c = (/ (- (call min (call max (.x r) (.y r)) (call min (call max (.y r) (.z r)) (call max (.z r) (.x r)))) 1) s)");
+    CHECK(inner.stmts[4]->kind == StmtKind::Assign);
+    REQUIRE(b.result != nullptr);
+    CHECK(sx(b.result.get()) == "d");
+    CHECK(b.result->loc.line == 12);
+    CHECK(b.result->loc.col == 5);
+    CHECK(sx_stmt(&p.stmt(2)) == "(call menger 4)");
+    // The bound form.
+    CHECK(ex("field(bound = 2) (p) -> length(p) - 1") == "(field bound=2 (p) (- (call length p) 1))");
+    CHECK(ex("field(2)(q) -> q.x") == "(field 2 (q) (.x q))");
+    CHECK(ex("field ( p ) -> p") == "(field (p) p)");
+}
+
+// ----------------------------------------------------------------------- expressions
+
+TEST_CASE("operator precedence and associativity", "[parser]") {
+    CHECK(ex("1 + 2 * 3") == "(+ 1 (* 2 3))");
+    CHECK(ex("1 * 2 + 3") == "(+ (* 1 2) 3)");
+    CHECK(ex("1 - 2 - 3") == "(- (- 1 2) 3)");
+    CHECK(ex("8 / 4 / 2 % 3") == "(% (/ (/ 8 4) 2) 3)");
+    CHECK(ex("-a.x") == "(neg (.x a))");
+    CHECK(ex("-a * b") == "(* (neg a) b)");
+    CHECK(ex("!a && b") == "(&& (not a) b)");
+    CHECK(ex("- -a") == "(neg (neg a))");
+    CHECK(ex("a ? b : c ? d : e") == "(? a b (? c d e))");
+    CHECK(ex("a ? b ? c : d : e") == "(? a (? b c d) e)");
+    CHECK(ex("a || b && c") == "(|| a (&& b c))");
+    CHECK(ex("a && b || c") == "(|| (&& a b) c)");
+    CHECK(ex("a < b < c") == "(< (< a b) c)");
+    CHECK(ex("a == b != c") == "(!= (== a b) c)");
+    CHECK(ex("a <= b + 1") == "(<= a (+ b 1))");
+    CHECK(ex("a >= b && c > d") == "(&& (>= a b) (> c d))");
+    CHECK(ex("1 + 2 == 3 ? x : y") == "(? (== (+ 1 2) 3) x y)");
+    CHECK(ex("(1 + 2) * 3") == "(* (+ 1 2) 3)");
+    CHECK(ex("a-1") == "(- a 1)");
+    CHECK(ex("a*-1") == "(* a (neg 1))");
+    CHECK(ex("k > 0 ? sphere(1) : { box(1); }") == "(? (> k 0) (call sphere 1) {(call box 1); })");
+    CHECK(ex("translate(v) box(1) + 1") == "(+ (apply (call translate v) (call box 1)) 1)");
+}
+
+TEST_CASE("postfix: calls, indexing, swizzles", "[parser]") {
+    CHECK(ex("box(2)(p)") == "(call (call box 2) p)");
+    CHECK(ex("f()") == "(call f)");
+    CHECK(ex("f(1, 2,)") == "(call f 1 2)");
+    CHECK(ex("torus(major = 1, minor = 0.2)") == "(call torus major=1 minor=0.2)");
+    CHECK(ex("f(1, b = 2, 3)") == "(call f 1 b=2 3)");
+    CHECK(ex("f(a == b)") == "(call f (== a b))");
+    CHECK(ex("v[0]") == "(index v 0)");
+    CHECK(ex("m[1][2]") == "(index (index m 1) 2)");
+    CHECK(ex("p.xyz") == "(.xyz p)");
+    CHECK(ex("c.rgba") == "(.rgba c)");
+    CHECK(ex("p.zyx.x") == "(.x (.zyx p))");
+    CHECK(ex("v[0].x") == "(.x (index v 0))");
+    CHECK(ex("f(p).xy") == "(.xy (call f p))");
+    CHECK(ex("(a + b).x") == "(.x (+ a b))");
+    CHECK(ex("[1, 2, 3].z") == "(.z [1 2 3])");
+    // `.5` after an expression is a number, not a swizzle (and two expressions in a row).
+    CHECK(error_of("x = a .5;") == "1:6: expected ';' after the statement");
+}
+
+TEST_CASE("vectors and ranges", "[parser]") {
+    CHECK(ex("[0 : 2]") == "(range 0 2)");
+    CHECK(ex("[0:0.5:2]") == "(range 0 0.5 2)");
+    CHECK(ex("[-n : 2 * n]") == "(range (neg n) (* 2 n))");
+    CHECK(ex("[a ? 1 : 2 : 3]") == "(range (? a 1 2) 3)");
+    CHECK(ex("[1, 2, 3]") == "[1 2 3]");
+    CHECK(ex("[1, 2, 3, 4,]") == "[1 2 3 4]");
+    CHECK(ex("[x]") == "[x]");
+    CHECK(ex("[]") == "[]");
+    CHECK(ex("[[1, 2], [3, 4]]") == "[[1 2] [3 4]]");
+    Parsed p = parse_text("x = [0 : 2];");
+    const Expr& r = *p.stmt(0).value;
+    REQUIRE(r.kind == ExprKind::Range);
+    REQUIRE(r.elems.size() == 3);
+    CHECK(r.elems[1] == nullptr);
+    CHECK(r.loc.col == 5);
+}
+
+TEST_CASE("numbers", "[parser]") {
+    auto num = [](const std::string& s) {
+        Parsed p = parse_text("x = " + s + ";");
+        const Expr& e = *p.stmt(0).value;
+        REQUIRE(e.kind == ExprKind::Number);
+        return e.number;
+    };
+    CHECK(num("1") == 1.0);
+    CHECK(num("1.5") == 1.5);
+    CHECK(num(".5") == 0.5);
+    CHECK(num("1e-3") == 0.001);
+    CHECK(num("2.") == 2.0);
+    CHECK(num("1E+2") == 100.0);
+    CHECK(num("2.5e1") == 25.0);
+    CHECK(num("007") == 7.0);
+    CHECK(ex("-1") == "(neg 1)");
+    CHECK(error_of("x = 1e;") == "1:7: expected digits in the number's exponent");
+    CHECK(error_of("x = 1e400;") == "1:5: number '1e400' is out of range");
+}
+
+TEST_CASE("strings and escapes", "[parser]") {
+    auto str = [](const std::string& s) {
+        Parsed p = parse_text("x = " + s + ";");
+        const Expr& e = *p.stmt(0).value;
+        REQUIRE(e.kind == ExprKind::String);
+        return e.text;
+    };
+    CHECK(str(R"("plain")") == "plain");
+    CHECK(str(R"("")") == "");
+    CHECK(str(R"("say \"hi\"")") == "say \"hi\"");
+    CHECK(str(R"("back\\slash")") == "back\\slash");
+    CHECK(str(R"("a\nb\tc")") == "a\nb\tc");
+    CHECK(str(R"("ünïcødé ✓")") == "ünïcødé ✓");
+    CHECK(str(R"("// not a comment /*")") == "// not a comment /*");
+    CHECK(sx1(R"(camera(projection = "orthographic");)") == "(call camera projection=\"orthographic\")");
+}
+
+TEST_CASE("comments and whitespace", "[parser]") {
+    Parsed p = parse_text("// leading\n/* block\n comment */ sphere(1); // trailing\n"
+                          "box(/* inline */ 2) /* between */ ;\r\n\ttorus(1, /**/ 0.2);//\n/***/");
+    REQUIRE(p.size() == 3);
+    CHECK(sx_stmt(&p.stmt(0)) == "(call sphere 1)");
+    CHECK(p.stmt(0).loc.line == 3);
+    CHECK(p.stmt(0).loc.col == 13);
+    CHECK(sx_stmt(&p.stmt(1)) == "(call box 2)");
+    CHECK(p.stmt(2).loc.line == 5);
+    CHECK(p.stmt(2).loc.col == 2);
+    CHECK(ex("a /* x */ / b") == "(/ a b)");
+    CHECK(ex("a//x\n+ b") == "(+ a b)");
+    CHECK(parse_text("").size() == 0);
+    CHECK(parse_text("  \n// only a comment").size() == 0);
+    CHECK(sx1("\xEF\xBB\xBFsphere(1);") == "(call sphere 1)");  // a UTF-8 byte order mark
+}
+
+TEST_CASE("keywords are not prefixes of names", "[parser]") {
+    CHECK(ex("letter + format + iffy + forest + trueish + variable + definition + elsewhere + imports + fieldx") ==
+          "(+ (+ (+ (+ (+ (+ (+ (+ (+ letter format) iffy) forest) trueish) variable) definition) elsewhere) imports) "
+          "fieldx)");
+    CHECK(ex("true && !false") == "(&& true (not false))");
+    CHECK(sx1("let letter = 1;") == "let letter = 1");
+    CHECK(error_of("let for = 1;") == "1:5: expected a name after 'let' ('for' is a keyword)");
+    CHECK(error_of("x = let;") == "1:5: expected an expression after '='");
+}
+
+TEST_CASE("modifier chains", "[parser]") {
+    CHECK(sx1("material(gold) torus(0.8, 0.25);") == "(apply (call material gold) (call torus 0.8 0.25))");
+    CHECK(sx1("for (i = [0 : 2]) translate([i, 0, 0]) rotate(x = 90 + 30 * i) material(gold) torus(0.8, 0.25);") ==
+          "for (i (range 0 2)) (apply (call translate [i 0 0]) (apply (call rotate x=(+ 90 (* 30 i))) "
+          "(apply (call material gold) (call torus 0.8 0.25))))");
+    // Targets: a name, a block, a for, an if, a field.
+    CHECK(sx1("translate(v) s;") == "(apply (call translate v) s)");
+    CHECK(sx1("scale(2) union { a; b; }") == "(apply (call scale 2) (apply union {a; b; }))");
+    CHECK(sx1("translate(v) for (i = [0 : 2]) rotate(y = i) box(1);") ==
+          "(apply (call translate v) (for (i (range 0 2)) (apply (call rotate y=i) (call box 1))))");
+    CHECK(sx1("translate(v) if (c) box(1) else sphere(1);") ==
+          "(apply (call translate v) (if c (call box 1) (call sphere 1)))");
+    CHECK(sx1("translate(v) if (c) box(1);") == "(apply (call translate v) (if c (call box 1)))");
+    CHECK(sx1("material(m) field (p) -> length(p) - 1;") ==
+          "(apply (call material m) (field (p) (- (call length p) 1)))");
+    CHECK(sx1("let s = translate([1, 0, 0]) sphere(1);") ==
+          "let s = (apply (call translate [1 0 0]) (call sphere 1))");
+    CHECK(sx1("f(translate(v) box(1), 2);") == "(call f (apply (call translate v) (call box 1)) 2)");
+    // Apply positions: the modifier's first character.
+    Parsed p = parse_text("  translate(v)\n    box(1);");
+    const Expr& a = *p.stmt(0).value;
+    REQUIRE(a.kind == ExprKind::Apply);
+    CHECK(a.loc.line == 1);
+    CHECK(a.loc.col == 3);
+    CHECK(a.rhs->loc.line == 2);
+    CHECK(a.rhs->loc.col == 5);
+    // Only a call or a name modifies.
+    CHECK(error_of("v.x sphere(1);") == "1:5: only a call or a name can be applied to a shape (is a ';' missing?)");
+    CHECK(error_of("x = 1 sphere(1);") == "1:6: expected ';' after the statement");
+}
+
+TEST_CASE("for and if as expressions", "[parser]") {
+    CHECK(ex("if (a) 1 else 2") == "(if a 1 2)");
+    Parsed p = parse_text("x = if (a) 1;");
+    const Expr& e = *p.stmt(0).value;
+    REQUIRE(e.kind == ExprKind::If);
+    REQUIRE(e.elems.size() == 3);
+    CHECK(e.elems[2] == nullptr);
+    CHECK(ex("for (i = [0 : 3], j = v) sphere(i)") == "(for (i (range 0 3))(j v) (call sphere i))");
+}
+
+// ------------------------------------------------------------------------ statements
+
+TEST_CASE("statements", "[parser]") {
+    CHECK(sx1("var d = 1;") == "var d = 1");
+    CHECK(sx1("d = max(d, c);") == "d = (call max d c)");
+    CHECK(sx1("d == 1;") == "(== d 1)");
+    CHECK(sx1(";") == "empty");
+    CHECK(sx1("if (a) if (b) x; else y;") == "if a then if b then x else y");
+    CHECK(sx1("if (a) { x; } else { y; }") == "if a then {x; } else {y; }");
+    CHECK(sx1("if (a) union { x; }") == "if a then (apply union {x; })");
+    CHECK(sx1("for (i = [0:2]) { sphere(i); }") == "for (i (range 0 2)) {(call sphere i); }");
+    CHECK(sx1("for (i = v) { }") == "for (i v) {}");
+    CHECK(sx1("{ a; b; }") == "{a; b; }");
+    CHECK(sx1("def f(x) { sphere(x); box(x); }") == "def f(x) = {(call sphere x); (call box x); }");
+    CHECK(sx1("def g() = 1;") == "def g() = 1");
+    CHECK(sx1("def h(a, b = 2,) = a;") == "def h(a, b = 2) = a");
+    CHECK(sx1(R"(import "a b/c.sdf";)") == "import \"a b/c.sdf\"");
+}
+
+TEST_CASE("statements ending with a block need no ';'", "[parser]") {
+    Parsed p = parse_text("difference { box(1); sphere(0.6); }\nsphere(2);\n"
+                          "union { a; } ;\n"
+                          "for (i = [0:1]) translate([i,0,0]) { box(1); } b;\n"
+                          "{ c; } d;\n"
+                          "smooth_union(0.3) { e; } /* c */ f;");
+    REQUIRE(p.size() == 9);
+    CHECK(sx_stmt(&p.stmt(0)) == "(apply difference {(call box 1); (call sphere 0.6); })");
+    CHECK(sx_stmt(&p.stmt(1)) == "(call sphere 2)");
+    CHECK(sx_stmt(&p.stmt(2)) == "(apply union {a; })");  // the ';' belongs to it
+    CHECK(sx_stmt(&p.stmt(3)) == "for (i (range 0 1)) (apply (call translate [i 0 0]) {(call box 1); })");
+    CHECK(sx_stmt(&p.stmt(4)) == "b");
+    CHECK(sx_stmt(&p.stmt(5)) == "{c; }");
+    CHECK(sx_stmt(&p.stmt(6)) == "d");
+    CHECK(sx_stmt(&p.stmt(7)) == "(apply (call smooth_union 0.3) {e; })");
+    CHECK(sx_stmt(&p.stmt(8)) == "f");
+    // A let needs its ';' even after a block.
+    CHECK(error_of("let u = { a; }\nb;") == "1:15: expected ';' after the statement");
+    // ... and so does a parenthesised block.
+    CHECK(error_of("({ a; })\nb;") == "1:9: expected ';' after the statement");
+}
+
+TEST_CASE("block results", "[parser]") {
+    CHECK(ex("{ d }") == "{=> d}");
+    CHECK(ex("{ sphere(1); box(1) }") == "{(call sphere 1); => (call box 1)}");
+    CHECK(ex("{ let a = 1; a + 1 }") == "{let a = 1; => (+ a 1)}");
+    CHECK(ex("{ a; }") == "{a; }");
+    CHECK(ex("{}") == "{}");
+    CHECK(ex("{ ; }") == "{empty; }");
+    CHECK(ex("{ union { a; } }") == "{(apply union {a; }); }");
+    CHECK(ex("{ { 1 } }") == "{{=> 1}; }");
+    // Only directly inside a block: an if body still needs its ';'.
+    CHECK(error_of("x = { if (a) b };") == "1:15: expected ';' after the statement");
+    Parsed p = parse_text("x = {\n  1\n};");
+    const Expr& b = *p.stmt(0).value;
+    REQUIRE(b.kind == ExprKind::BlockExpr);
+    CHECK(b.loc.col == 5);
+    CHECK(b.block->loc.col == 5);
+    CHECK(b.block->result->loc.line == 2);
+}
+
+TEST_CASE("locations", "[parser]") {
+    Parsed p = parse_text("let a = 1;\n  sphere(r = 2, 3);\r\nx = (1 + 2) * 3;\n\t f(g)(h);");
+    const Stmt& call = p.stmt(1);
+    CHECK(call.loc.line == 2);
+    CHECK(call.loc.col == 3);
+    CHECK(call.loc.file == p.file.get());
+    const Expr& c = *call.value;
+    CHECK(c.loc.col == 3);
+    CHECK(c.callee->loc.col == 3);
+    REQUIRE(c.args.size() == 2);
+    CHECK(c.args[0].loc.col == 10);  // the name of a named argument
+    CHECK(c.args[0].value->loc.col == 14);
+    CHECK(c.args[1].loc.col == 17);  // the value of a positional one
+    const Stmt& assign = p.stmt(2);
+    CHECK(assign.loc.line == 3);
+    CHECK(assign.name_loc.col == 1);
+    const Expr& mul = *assign.value;
+    CHECK(mul.loc.col == 5);        // the '(' of the first operand
+    CHECK(mul.lhs->loc.col == 6);   // the sum itself starts after it
+    CHECK(mul.rhs->loc.col == 15);
+    const Expr& fgh = *p.stmt(3).value;
+    CHECK(fgh.loc.line == 4);
+    CHECK(fgh.loc.col == 3);
+    CHECK(fgh.callee->loc.col == 3);
+    CHECK(p.module->file == p.file.get());
+}
+
+// ------------------------------------------------------------------------- errors
+
+TEST_CASE("syntax errors: text and position", "[parser]") {
+    CHECK(error_of("sphere(1;") == "1:9: expected ')'");
+    CHECK(error_of("x = (1 + 2;") == "1:11: expected ')'");
+    CHECK(error_of("let a = 1\nlet b = 2;") == "1:10: expected ';' after the statement");
+    CHECK(error_of("sphere(1) // a comment\n\n") == "1:10: expected ';' after the statement");
+    CHECK(error_of("box(1) /* a\n comment */") == "1:7: expected ';' after the statement");
+    CHECK(error_of("x = \"s\" y = 2;") == "1:8: expected ';' after the statement");
+    CHECK(error_of("a;\n  /* never closed\n") == "2:3: unterminated comment");
+    CHECK(error_of("import \"lib/a.sdf;\n") == "1:8: unterminated string");
+    CHECK(error_of("x = \"abc") == "1:5: unterminated string");
+    CHECK(error_of("x = \"a\\qb\";") == "1:7: unknown escape sequence in a string (use \\\", \\\\, \\n or \\t)");
+    CHECK(error_of("sphere(1) @ box(2);") == "1:11: unexpected character '@'");
+    CHECK(error_of("x = 1 # 2;") == "1:7: unexpected character '#'");
+    CHECK(error_of("x = a & b;") == "1:7: unexpected character '&' (did you mean '&&'?)");
+    CHECK(error_of("x = é;") == "1:5: unexpected character 'é'");
+    CHECK(error_of("x = 1 +;") == "1:8: expected an expression after the operator");
+    CHECK(error_of("x = a ||\n;") == "2:1: expected an expression after '||'");
+    CHECK(error_of("x = -;") == "1:6: expected an expression after '-'");
+    CHECK(error_of("x = ();") == "1:6: expected an expression");
+    CHECK(error_of("x = a ? b;") == "1:10: expected ':' in the conditional expression (cond ? a : b)");
+    CHECK(error_of("f(1 2);") == "1:5: expected ')'");
+    CHECK(error_of("x = [1, 2 3];") == "1:11: expected ',' or ']'");
+    CHECK(error_of("x = [0 : 1 : 2 : 3];") == "1:16: expected ']' to close the range");
+    CHECK(error_of("x = v[1;") == "1:8: expected ']'");
+    CHECK(error_of("x = v.;") == "1:7: expected swizzle letters (such as .xyz) after '.'");
+    CHECK(error_of("x = field (p) p;") == "1:15: expected '->' after the field's parameter");
+    CHECK(error_of("x = field p -> p;") == "1:11: expected '(' and the field's parameter name, as in field (p) -> ...");
+    CHECK(error_of("x = field (p) ->;") == "1:17: expected an expression after '->'");
+    CHECK(error_of("union { a; ") == "1:12: expected '}'");
+    CHECK(error_of("union { a; )") == "1:12: expected '}'");
+    CHECK(error_of("a; }") == "1:4: unmatched '}'");
+    CHECK(error_of(")") == "1:1: expected a statement");
+    CHECK(error_of("if (a) else b;") == "1:8: expected a statement");
+    CHECK(error_of("if a) b;") == "1:4: expected '(' after 'if'");
+    CHECK(error_of("if () b;") == "1:5: expected a condition");
+    CHECK(error_of("if (a b;") == "1:8: expected ')' after the condition");
+    CHECK(error_of("for i = [0:1]) b;") == "1:5: expected '(' after 'for'");
+    CHECK(error_of("for (1) b;") == "1:6: expected a loop variable name");
+    CHECK(error_of("for (i [0:1]) b;") == "1:8: expected '=' after the name");
+    CHECK(error_of("for (i = ) b;") == "1:10: expected a range or a vector to iterate over");
+    CHECK(error_of("for (i = v; b;") == "1:11: expected ')' after the loop variables");
+    CHECK(error_of("let = 1;") == "1:5: expected a name after 'let'");
+    CHECK(error_of("var 1 = 1;") == "1:5: expected a name after 'var'");
+    CHECK(error_of("let a 1;") == "1:7: expected '=' after the name");
+    CHECK(error_of("let a = ;") == "1:9: expected an expression after '='");
+    CHECK(error_of("def (x) = 1;") == "1:5: expected a name after 'def'");
+    CHECK(error_of("def f = 1;") == "1:7: expected '(' after the function name");
+    CHECK(error_of("def f(a, 1) = 1;") == "1:10: expected a parameter name");
+    CHECK(error_of("def f(1) = 1;") == "1:7: expected a parameter name");
+    CHECK(error_of("def f(a, if) = 1;") == "1:10: expected a parameter name ('if' is a keyword)");
+    CHECK(error_of("let a for") == "1:7: expected '=' after the name");
+    CHECK(error_of("x = 'a';") == "1:5: unexpected character \"'\" (strings are written in double quotes)");
+    CHECK(error_of("def f(a b) = 1;") == "1:9: expected ')' after the parameters");
+    CHECK(error_of("def f(a) a;") == "1:10: expected '=' or '{' after the parameters");
+    CHECK(error_of("def f(a) = a") == "1:13: expected ';' after the statement");
+    CHECK(error_of("import lib;") == "1:8: expected a path string after 'import'");
+    CHECK(error_of("f(x = );") == "1:7: expected an expression after '='");
+    // Errors on later lines, after multi-byte characters (columns count bytes).
+    CHECK(error_of("// ñ\nlet é = 1;") == "2:5: unexpected character 'é'");
+    CHECK(error_of("x = \"ñ\" +;") == "1:11: expected an expression after the operator");
+}
+
+TEST_CASE("the formatted diagnostic quotes the line with a caret", "[parser]") {
+    SourceFile f("scene.sdf", "sphere(1);\ntranslate([1, 0, 0] box(1);\n");
+    try {
+        parse(f);
+        FAIL("no error");
+    } catch (const CompileError& e) {
+        CHECK(e.formatted() ==
+              "scene.sdf:2:21: error: expected ')'\n"
+              "translate([1, 0, 0] box(1);\n"
+              "                    ^\n");
+    }
+}
+
+// ---------------------------------------------------------------------- nesting limit
+
+TEST_CASE("deep nesting is an error, not a crash", "[parser]") {
+    const int n = 100000;
+    auto message = [](const std::string& text) {
+        SourceFile f("deep.sdf", text);
+        try {
+            parse(f);
+        } catch (const CompileError& e) {
+            return e.diagnostics().at(0).message;
+        }
+        return std::string("no error");
+    };
+    const std::string limit = "nesting deeper than 256 levels";
+    CHECK(message(std::string(n, '(') + "1" + std::string(n, ')') + ";") == limit);
+    CHECK(message(std::string(n, '{') + std::string(n, '}')) == limit);
+    CHECK(message(std::string(n, '{')) == limit);
+    CHECK(message("x = " + std::string(n, '[') + "1" + std::string(n, ']') + ";") == limit);
+    CHECK(message("x = " + std::string(n, '-') + "1;") == limit);
+    CHECK(message("x = " + std::string(n, '!') + "1;") == limit);
+    std::string s;
+    for (int i = 0; i < n; ++i) s += "f(";
+    CHECK(message(s) == limit);
+    s.clear();
+    for (int i = 0; i < n; ++i) s += "a ";
+    CHECK(message(s + "b;") == limit);
+    s.clear();
+    for (int i = 0; i < n; ++i) s += "if (c) ";
+    CHECK(message(s + "a;") == limit);
+    s.clear();
+    for (int i = 0; i < n; ++i) s += "a ? b : ";
+    CHECK(message("x = " + s + "c;") == limit);
+    s.clear();
+    for (int i = 0; i < n; ++i) s += "field (p) -> ";
+    CHECK(message("x = " + s + "1;") == limit);
+    // Long flat chains build tall trees: bounded too.
+    s = "x = 1";
+    for (int i = 0; i < n; ++i) s += " + 1";
+    CHECK_THAT(message(s + ";"), Catch::Matchers::StartsWith("expression nested deeper than"));
+    s = "x = f";
+    for (int i = 0; i < n; ++i) s += "(1)";
+    CHECK_THAT(message(s + ";"), Catch::Matchers::StartsWith("expression nested deeper than"));
+    s = "x = v";
+    for (int i = 0; i < n; ++i) s += ".x";
+    CHECK_THAT(message(s + ";"), Catch::Matchers::StartsWith("expression nested deeper than"));
+}
+
+TEST_CASE("the nesting limit is a parameter", "[parser]") {
+    ParseOptions opts;
+    opts.max_nesting = 10;
+    CHECK(error_of("x = ((((((((((1))))))))));", opts) == "1:14: nesting deeper than 10 levels");
+    CHECK_NOTHROW(parse_text("x = ((((((1))))));", opts));
+    // The default allows realistic depth.
+    std::string s = "x = " + std::string(200, '(') + "1" + std::string(200, ')') + ";";
+    CHECK_NOTHROW(parse_text(s));
+    s = "union { difference { translate(v) rotate(a) scale(2) { smooth_union(0.1) { a; b; } } } }";
+    CHECK_NOTHROW(parse_text(s));
+    s.clear();
+    for (int i = 0; i < 200; ++i) s += "{";
+    for (int i = 0; i < 200; ++i) s += "}";
+    CHECK_NOTHROW(parse_text(s));
+    s = "x = 0";
+    for (int i = 0; i < 500; ++i) s += " + 1";
+    CHECK_NOTHROW(parse_text(s + ";"));
+}
+
+// --------------------------------------------------------------------------- dump
+
+TEST_CASE("dump lists the tree", "[parser][dump]") {
+    Parsed p = parse_text("let r = 0.5;\n"
+                          "def ring(R, t = 0.1) = rotate(x = 90) torus(R, t);\n"
+                          "if (r > 0.3) sphere(r); else box(-r);\n"
+                          "for (i = [0 : 0.5 : 2]) union { ring(i); v.xy[1]; }\n"
+                          "import \"lib/a.sdf\";\n"
+                          "x = field(bound = 2) (p) -> { var d = p.x; d };\n"
+                          "f(1)(p) ? true : \"s\";\n");
+    CHECK(dump(*p.module) ==
+          "let r @1:1\n"
+          "  number 0.5\n"
+          "def ring @2:1\n"
+          "  param R\n"
+          "  param t =\n"
+          "    number 0.1\n"
+          "  apply\n"
+          "    call rotate\n"
+          "      arg x =\n"
+          "        number 90\n"
+          "    call torus\n"
+          "      arg\n"
+          "        ident R\n"
+          "      arg\n"
+          "        ident t\n"
+          "if @3:1\n"
+          "  binary >\n"
+          "    ident r\n"
+          "    number 0.3\n"
+          "  then\n"
+          "    expr @3:14\n"
+          "      call sphere\n"
+          "        arg\n"
+          "          ident r\n"
+          "  else\n"
+          "    expr @3:30\n"
+          "      call box\n"
+          "        arg\n"
+          "          unary -\n"
+          "            ident r\n"
+          "for @4:1\n"
+          "  binding i\n"
+          "    range with step\n"
+          "      number 0\n"
+          "      number 0.5\n"
+          "      number 2\n"
+          "  expr @4:25\n"
+          "    apply\n"
+          "      ident union\n"
+          "      block\n"
+          "        expr @4:33\n"
+          "          call ring\n"
+          "            arg\n"
+          "              ident i\n"
+          "        expr @4:42\n"
+          "          index\n"
+          "            swizzle .xy\n"
+          "              ident v\n"
+          "            number 1\n"
+          "import \"lib/a.sdf\" @5:1\n"
+          "assign x @6:1\n"
+          "  field (p)\n"
+          "    arg bound =\n"
+          "      number 2\n"
+          "    block\n"
+          "      var d @6:31\n"
+          "        swizzle .x\n"
+          "          ident p\n"
+          "      result\n"
+          "        ident d\n"
+          "expr @7:1\n"
+          "  ternary\n"
+          "    call\n"
+          "      callee\n"
+          "        call f\n"
+          "          arg\n"
+          "            number 1\n"
+          "      arg\n"
+          "        ident p\n"
+          "    bool true\n"
+          "    string \"s\"\n");
+}

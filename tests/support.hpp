@@ -1,0 +1,55 @@
+// Helpers shared by the test suites: compile a script from a string, evaluate distances,
+// capture the first diagnostic.
+#pragma once
+#include <string>
+
+#include "compiler/compile.hpp"
+#include "lang/interpreter.hpp"
+#include "runtime/vm.hpp"
+
+namespace sdfc::test {
+
+struct Compiled {
+    SourceManager sm;
+    Scene scene;
+    CompiledScene cs;
+};
+
+// Compiles `src` as if it were the file `name`. Throws CompileError.
+inline std::unique_ptr<Compiled> compile_text(const std::string& src, const std::string& name = "test.sdf",
+                                              InterpretOptions opts = {}) {
+    auto c = std::make_unique<Compiled>();
+    const SourceFile& f = c->sm.add(name, src);
+    c->scene = interpret_source(c->sm, f, opts);
+    c->cs = compile_scene(c->scene);
+    return c;
+}
+
+// The distance program at one point (batch VM, one lane).
+inline float dist(const CompiledScene& cs, float x, float y, float z) {
+    Evaluator ev(cs.distance);
+    return ev.eval1(x, y, z, cs.time);
+}
+
+inline float dist_of(const std::string& src, float x, float y, float z) {
+    auto c = compile_text(src);
+    return dist(c->cs, x, y, z);
+}
+
+// The full formatted diagnostics of compiling `src`, or "" if it compiles.
+inline std::string error_of(const std::string& src, const std::string& name = "test.sdf") {
+    try {
+        compile_text(src, name);
+    } catch (const CompileError& e) {
+        return e.formatted();
+    }
+    return "";
+}
+
+// Only the first line of the diagnostics.
+inline std::string first_error_line(const std::string& src) {
+    std::string e = error_of(src);
+    return e.substr(0, e.find('\n'));
+}
+
+}  // namespace sdfc::test
