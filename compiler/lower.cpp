@@ -311,8 +311,9 @@ Lowered lower_primitive(L& l, const Shape& s, const Vec3N& p) {
             break;
         }
         case ShapeKind::BoxFrame: {
+            // Quilez's sdBoxFrame makes bars 2e thick; ours are `e` thick.
             Vec3N b = P3(s, 0), a = l.abs3(p);
-            NodeId e = P(s, 3);
+            NodeId e = l.mul(P(s, 3), half);
             Vec3N pp, q;
             for (int i = 0; i < 3; ++i) {
                 pp[i] = l.sub(a[i], l.mul(b[i], half));
@@ -431,6 +432,9 @@ Lowered lower_primitive(L& l, const Shape& s, const Vec3N& p) {
             NodeId cnd = l.lt(zero, l.mn(qy, l.sub(l.mul(l.neg(qx), m2), l.mul(qy, half))));
             NodeId d2 = l.sel(cnd, zero, l.mn(a, b));
             d = l.mul(l.sqrt(l.div(l.add(d2, l.sq(qz)), m2)), g.unary(Op::Sign, l.mx(qz, l.neg(y))));
+            // Below the base his formula overestimates; there the nearest point is on the base square.
+            NodeId base = l.len3(l.mx(l.sub(ax, half), zero), y, l.mx(l.sub(az, half), zero));
+            d = l.sel(l.lt(y, zero), base, d);
             break;
         }
         case ShapeKind::HexPrism: {

@@ -49,7 +49,7 @@ enum class ExprKind {
     Vector,    // elems: [a, b, c]
     Range,     // lhs : [step] : rhs  ->  elems = {start, step?, end}; step null when absent
     Unary,     // un_op, lhs
-    Binary,    // bin_op, lhs, rhs
+    Binary,    // bin_op, lhs, rhs; loc is the operator's (errors about the operation point there)
     Ternary,   // cond ? lhs : rhs  -> elems = {cond, then, else}
     Call,      // callee(args)
     Index,     // lhs[rhs]

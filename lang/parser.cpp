@@ -33,17 +33,16 @@ namespace g = sdfc::grammar;
 
 enum class Tag : uint8_t { Expr, Stmt, Arg, Param, Binding, Name, Op, RangeMark, ResultMark };
 
+// Arg, Param and Binding items keep their parts in `name` and `expr` (the value, the
+// default, the iterable) until their parent node takes them.
 struct Item {
     Tag tag = Tag::Expr;
-    Loc loc;             // first character (for an Expr: including enclosing parentheses)
+    BinOp op = BinOp::Add;
     uint32_t height = 1; // height of the subtree
+    Loc loc;             // first character (for an Expr: including enclosing parentheses)
     ExprPtr expr;
     StmtPtr stmt;
-    Arg arg;
-    Param param;
-    ForBinding binding;
     std::string name;
-    BinOp op = BinOp::Add;
 };
 
 struct State {
@@ -52,6 +51,7 @@ struct State {
     unsigned max_height = 1024;
     std::vector<Item> items;
     std::vector<size_t> frames;
+    std::vector<Item> taken;  // reused by take()
     unsigned depth = 0;
     const char* block_end = nullptr;  // where the last block's `}` (and the space after it) ended
 
@@ -62,12 +62,14 @@ struct State {
     }
 
     // The items of the current rule (pushed since it started), removed from the stack.
-    std::vector<Item> take() {
+    // Valid until the next take(); an action takes once.
+    std::vector<Item>& take() {
         size_t f = frames.back();
-        std::vector<Item> out(std::make_move_iterator(items.begin() + static_cast<ptrdiff_t>(f)),
-                              std::make_move_iterator(items.end()));
+        taken.clear();
+        taken.insert(taken.end(), std::make_move_iterator(items.begin() + static_cast<ptrdiff_t>(f)),
+                     std::make_move_iterator(items.end()));
         items.resize(f);
-        return out;
+        return taken;
     }
     // The item just below the current rule's frame (what a postfix rule extends), removed.
     Item take_below() {
@@ -238,16 +240,17 @@ template <> struct action<g::op_mul> : op_action<BinOp::Mul> {};
 template <> struct action<g::op_div> : op_action<BinOp::Div> {};
 template <> struct action<g::op_mod> : op_action<BinOp::Mod> {};
 
-// `a op b op c` -> ((a op b) op c)
+// `a op b op c` -> ((a op b) op c). A Binary node's loc is its operator (where errors such
+// as "division by zero" belong); the item keeps the first character for enclosing nodes.
 struct fold_action {
     template <typename In>
     static void apply(const In&, State& st) {
         if (st.items.size() - st.frames.back() == 1) return;
-        auto items = st.take();
+        auto& items = st.take();
         Item acc = std::move(items[0]);
         for (size_t i = 1; i + 1 < items.size(); i += 2) {
             Item& rhs = items[i + 1];
-            auto e = make(ExprKind::Binary, acc.loc);
+            auto e = make(ExprKind::Binary, items[i].loc);
             e->bin_op = items[i].op;
             e->lhs = std::move(acc.expr);
             e->rhs = std::move(rhs.expr);
@@ -268,7 +271,7 @@ template <UnOp Op>
 struct unary_action {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Loc loc = st.loc(in.position());
         auto e = make(ExprKind::Unary, loc);
         e->un_op = Op;
@@ -283,7 +286,7 @@ template <>
 struct action<g::ternary_tail> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Item cond = st.take_below();
         auto e = make(ExprKind::Ternary, cond.loc);
         uint32_t h = 1 + std::max(cond.height, max_height(items));
@@ -307,25 +310,20 @@ template <>
 struct action<g::arg> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Item it;
         it.tag = Tag::Arg;
-        if (items.size() == 2) {  // name = value
-            it.arg.loc = items[0].loc;
-            it.arg.name = std::move(items[0].name);
-        } else {
-            it.arg.loc = items[0].loc;
-        }
-        it.loc = it.arg.loc;
+        it.loc = items[0].loc;  // the name, or the value of a positional argument
+        if (items.size() == 2) it.name = std::move(items[0].name);
         it.height = items.back().height;
-        it.arg.value = std::move(items.back().expr);
+        it.expr = std::move(items.back().expr);
         st.items.push_back(std::move(it));
     }
 };
 
 std::vector<Arg> take_args(std::vector<Item>& items, size_t begin, size_t end) {
     std::vector<Arg> args;
-    for (size_t i = begin; i < end; ++i) args.push_back(std::move(items[i].arg));
+    for (size_t i = begin; i < end; ++i) args.push_back(Arg{items[i].loc, std::move(items[i].name), std::move(items[i].expr)});
     return args;
 }
 
@@ -333,7 +331,7 @@ template <>
 struct action<g::call_suffix> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Item callee = st.take_below();
         auto e = make(ExprKind::Call, callee.loc);
         uint32_t h = 1 + std::max(callee.height, max_height(items));
@@ -347,7 +345,7 @@ template <>
 struct action<g::index_suffix> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Item lhs = st.take_below();
         auto e = make(ExprKind::Index, lhs.loc);
         uint32_t h = 1 + std::max(lhs.height, items[0].height);
@@ -384,7 +382,7 @@ template <>
 struct action<g::bracket_expr> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Loc loc = st.loc(in.position());
         bool range = !items.empty() && items.back().tag == Tag::RangeMark;
         if (range) items.pop_back();
@@ -405,14 +403,13 @@ template <>
 struct action<g::binding> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Item it;
         it.tag = Tag::Binding;
         it.loc = items[0].loc;
         it.height = items[1].height;
-        it.binding.loc = items[0].loc;
-        it.binding.name = std::move(items[0].name);
-        it.binding.iterable = std::move(items[1].expr);
+        it.name = std::move(items[0].name);
+        it.expr = std::move(items[1].expr);
         st.items.push_back(std::move(it));
     }
 };
@@ -420,7 +417,7 @@ struct action<g::binding> {
 std::vector<ForBinding> take_bindings(std::vector<Item>& items) {
     std::vector<ForBinding> out;
     for (auto& it : items)
-        if (it.tag == Tag::Binding) out.push_back(std::move(it.binding));
+        if (it.tag == Tag::Binding) out.push_back(ForBinding{it.loc, std::move(it.name), std::move(it.expr)});
     return out;
 }
 
@@ -428,7 +425,7 @@ template <>
 struct action<g::for_expr> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Loc loc = st.loc(in.position());
         auto e = make(ExprKind::For, loc);
         uint32_t h = 1 + max_height(items);
@@ -444,7 +441,7 @@ template <>
 struct action<g::if_expr> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Loc loc = st.loc(in.position());
         auto e = make(ExprKind::If, loc);
         uint32_t h = 1 + max_height(items);
@@ -458,7 +455,7 @@ template <>
 struct action<g::field_expr> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Loc loc = st.loc(in.position());
         auto e = make(ExprKind::Field, loc);
         uint32_t h = 1 + max_height(items);
@@ -482,7 +479,7 @@ template <>
 struct action<g::block> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Loc loc = st.loc(in.position());
         auto e = make(ExprKind::BlockExpr, loc);
         e->block = std::make_unique<Block>();
@@ -503,7 +500,7 @@ template <>
 struct action<g::apply_target> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Item mod = st.take_below();
         Item& target = items[0];
         if (mod.expr->kind != ExprKind::Call && mod.expr->kind != ExprKind::Ident)
@@ -522,7 +519,7 @@ template <StmtKind Kind>
 struct binding_stmt_action {  // let / var / assign: [name, value]
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         auto s = make_stmt(Kind, st.loc(in.position()));
         s->name = std::move(items[0].name);
         s->name_loc = items[0].loc;
@@ -537,14 +534,13 @@ template <> struct action<g::assign_stmt> : binding_stmt_action<StmtKind::Assign
 struct param_action {  // [name, default?]
     template <typename In>
     static void apply(const In&, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         Item it;
         it.tag = Tag::Param;
         it.loc = items[0].loc;
         it.height = items.back().height;
-        it.param.loc = items[0].loc;
-        it.param.name = std::move(items[0].name);
-        if (items.size() == 2) it.param.default_value = std::move(items[1].expr);
+        it.name = std::move(items[0].name);
+        if (items.size() == 2) it.expr = std::move(items[1].expr);
         st.items.push_back(std::move(it));
     }
 };
@@ -554,11 +550,12 @@ template <>
 struct action<g::def_stmt> {  // [name, params..., value]
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         auto s = make_stmt(StmtKind::Def, st.loc(in.position()));
         s->name = std::move(items.front().name);
         s->name_loc = items.front().loc;
-        for (size_t i = 1; i + 1 < items.size(); ++i) s->params.push_back(std::move(items[i].param));
+        for (size_t i = 1; i + 1 < items.size(); ++i)
+            s->params.push_back(Param{items[i].loc, std::move(items[i].name), std::move(items[i].expr)});
         s->value = std::move(items.back().expr);
         st.push_stmt(std::move(s), 1 + max_height(items));
     }
@@ -568,7 +565,7 @@ template <>
 struct action<g::import_stmt> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         auto s = make_stmt(StmtKind::Import, st.loc(in.position()));
         s->name = std::move(items[0].expr->text);
         s->name_loc = items[0].loc;
@@ -580,7 +577,7 @@ template <>
 struct action<g::if_stmt> {  // [cond, then, else?]
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         auto s = make_stmt(StmtKind::If, st.loc(in.position()));
         s->value = std::move(items[0].expr);
         s->then_branch = std::move(items[1].stmt);
@@ -593,7 +590,7 @@ template <>
 struct action<g::for_stmt> {  // [bindings..., body]
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         auto s = make_stmt(StmtKind::For, st.loc(in.position()));
         uint32_t h = 1 + max_height(items);
         s->body = std::move(items.back().stmt);
@@ -615,7 +612,7 @@ template <>
 struct action<g::expr_stmt> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto items = st.take();
+        auto& items = st.take();
         auto s = make_stmt(StmtKind::Expr, items[0].loc);
         s->value = std::move(items[0].expr);
         st.push_stmt(std::move(s), items[0].height + 1);

@@ -39,16 +39,12 @@ static std::string first_message(const std::vector<Diagnostic>& d) {
 }
 
 CompileError::CompileError(std::vector<Diagnostic> diags)
-    : std::runtime_error(first_message(diags)), diags_(std::move(diags)) {}
+    : std::runtime_error(first_message(diags)), diags_(std::move(diags)) {
+    for (const auto& d : diags_) formatted_ += format_diagnostic(d);
+}
 
 CompileError::CompileError(Loc loc, std::string message)
     : CompileError(std::vector<Diagnostic>{Diagnostic{loc, std::move(message)}}) {}
-
-std::string CompileError::formatted() const {
-    std::string s;
-    for (const auto& d : diags_) s += format_diagnostic(d);
-    return s;
-}
 
 static bool valid_utf8(std::string_view s, size_t& bad_at) {
     size_t i = 0;

@@ -41,11 +41,15 @@ class CompileError : public std::runtime_error {
 public:
     explicit CompileError(std::vector<Diagnostic> diags);
     CompileError(Loc loc, std::string message);
+    // Locations point into files that may be gone once the error has propagated out of
+    // the stage that loaded them: use them only while that stage is alive.
     const std::vector<Diagnostic>& diagnostics() const { return diags_; }
-    std::string formatted() const;  // all diagnostics, each formatted, joined
+    // All diagnostics, each formatted, joined; rendered when thrown, so always safe.
+    const std::string& formatted() const { return formatted_; }
 
 private:
     std::vector<Diagnostic> diags_;
+    std::string formatted_;
 };
 
 // Owns every loaded file so Locs stay valid for the whole compilation.

@@ -72,6 +72,7 @@ namespace {
 constexpr int kConeEvents = 4;
 constexpr int kAoTaps = 5;
 constexpr float kMinWeight = 1e-3f;
+constexpr float kRelax = 1.5f;  // over-relaxed sphere tracing factor (Keinert et al. 2014)
 constexpr int kMatOut = kMatChannels;  // material channels after the distance output
 
 // Rays (or hit points) in structure-of-arrays form. For a hit set, `o` is the hit point and
@@ -138,6 +139,9 @@ struct Frame {
     float eps = 1e-4f, max_dist = 100.0f, time = 0.0f;
     bool cone = false, shadows = true, ao = true, has_distance = true, has_material = true;
     bool clip = false;
+    // Raw fields (.vm models) make no Lipschitz claim: see march_raw().
+    bool raw = false;
+    float raw_lipschitz = 1.0f, raw_max_step = 0.05f;
     glm::vec3 lo{0}, hi{0};
     std::vector<glm::vec2> offsets;
     bool want_depth = false, want_normal = false, want_steps = false;
@@ -174,8 +178,9 @@ struct Frame {
 struct Lanes {
     alignas(64) float ox[kBatch], oy[kBatch], oz[kBatch], dx[kBatch], dy[kBatch], dz[kBatch];
     alignas(64) float t[kBatch], tmax[kBatch], t0[kBatch], sg[kBatch], w[kBatch], a[kBatch], b[kBatch];
+    alignas(64) float om[kBatch], pr[kBatch], sl[kBatch];  // over-relaxation: factor, previous radius, step
     alignas(64) float x[kBatch], y[kBatch], z[kBatch];
-    alignas(64) int32_t steps[kBatch], done[kBatch];
+    alignas(64) int32_t steps[kBatch], done[kBatch], idx[kBatch];
     alignas(64) uint32_t ray[kBatch];
     void load(int i, const RaySet& rs, uint32_t r) {
         ox[i] = rs.ox[r], oy[i] = rs.oy[r], oz[i] = rs.oz[r];
@@ -183,6 +188,7 @@ struct Lanes {
         t[i] = rs.tmin[r], tmax[i] = rs.tmax[r], t0[i] = rs.t0[r];
         sg[i] = rs.inside[r] ? -1.0f : 1.0f;
         w[i] = 0.0f, a[i] = 0.0f, b[i] = 0.0f;
+        om[i] = kRelax, pr[i] = 0.0f, sl[i] = 0.0f;
         steps[i] = 0, done[i] = 0;
         ray[i] = r;
     }
@@ -191,6 +197,7 @@ struct Lanes {
         dx[to] = dx[from], dy[to] = dy[from], dz[to] = dz[from];
         t[to] = t[from], tmax[to] = tmax[from], t0[to] = t0[from], sg[to] = sg[from];
         w[to] = w[from], a[to] = a[from], b[to] = b[from];
+        om[to] = om[from], pr[to] = pr[from], sl[to] = sl[from];
         steps[to] = steps[from], done[to] = done[from], ray[to] = ray[from];
     }
 };
@@ -254,13 +261,17 @@ private:
             dist_.eval(L.x, L.y, L.z, n, f_.time);
             stats.distance_points += static_cast<uint64_t>(n);
             update(L, n, dist_.output(0));
-            for (int i = 0; i < n;) {
-                if (L.done[i]) {
-                    finish(L, i);
-                    if (i != --n) L.move(n, i);
-                } else {
-                    ++i;
-                }
+            // Collect the finished lanes without branching, then swap-remove them from the
+            // highest index down (so the lane moved in is always a live one).
+            int nd = 0;
+            for (int i = 0; i < n; ++i) {
+                L.idx[nd] = i;
+                nd += L.done[i] != 0;
+            }
+            while (nd > 0) {
+                const int i = L.idx[--nd];
+                finish(L, i);
+                if (i != --n) L.move(n, i);
             }
         }
     }
@@ -288,6 +299,7 @@ private:
     }
 
     void march(const RaySet& rs);
+    void march_raw(const RaySet& rs, bool shadow);
     void cone_march(const RaySet& rs);
     void compute_normals(const RaySet& h);
     void compute_materials(const RaySet& h);
@@ -304,6 +316,7 @@ private:
 
 // Sphere tracing (outside rays on d, inside rays on -d). Results in t_, hit_, steps_.
 void Worker::march(const RaySet& rs) {
+    if (f_.raw) return march_raw(rs, false);
     const size_t n = rs.size();
     t_.resize(n);
     hit_.assign(n, 0);
@@ -314,13 +327,21 @@ void Worker::march(const RaySet& rs) {
         rs, [](Lanes&, int) {},
         [&](Lanes& L, int m, const float* d) {
             for (int i = 0; i < m; ++i) {
-                const float s = L.sg[i] * d[i];
+                const float s = L.sg[i] * d[i], r = std::fabs(s);
+                // Over-relaxation: step omega * d while consecutive unbounding spheres
+                // overlap; when they do not, a surface may lie between: step back inside the
+                // previous sphere and continue with omega = 1.
+                const bool fail = (L.om[i] > 1.0f) & (r + L.pr[i] < L.sl[i]);
+                const float step = fail ? (1.0f - L.om[i]) * L.sl[i] : L.om[i] * s;
+                L.om[i] = fail ? 1.0f : L.om[i];
+                L.sl[i] = step;
+                L.pr[i] = r;
                 const float thr = eps * std::max(L.t0[i] + L.t[i], 1.0f);
                 const int st = ++L.steps[i];
-                const bool stop = (s < thr) | (st >= max_steps);  // hit, or out of steps (decided in finish)
-                const float tn = L.t[i] + s;
+                const bool stop = ((s < thr) & !fail) | (st >= max_steps);  // hit, or out of steps (decided in finish)
+                const float tn = L.t[i] + step;
                 const bool out = !(tn <= L.tmax[i]);  // also NaN
-                L.a[i] = s;
+                L.a[i] = fail ? INFINITY : s;
                 L.t[i] = stop ? L.t[i] : tn;
                 L.done[i] = stop | out;
             }
@@ -333,6 +354,80 @@ void Worker::march(const RaySet& rs) {
             hit_[r] = s < f_.thr(path) || (L.steps[i] >= max_steps && s < f_.footprint(path));
         },
         [&](uint32_t r) { t_[r] = rs.tmax[r]; });
+}
+
+// Marching a raw field (no distance bound): steps of |f| / L, with L a Lipschitz estimate
+// sampled over the volume (render()), clamped to [one pixel footprint, raw_max_step]; a
+// sign change (f <= 0) is refined by bisection to the outside end of the bracket. Thin features
+// (under a pixel or where the estimate is low) can be missed: the price of no bound.
+// Lane state: a = previous t, b / w = bisection bracket (lo, hi), sl = bisection iterations
+// (0 while marching), om = 1 when the ray ended as a hit.
+// `shadow`: results go to vis_ (0 = blocked) instead of t_ / hit_ / steps_.
+void Worker::march_raw(const RaySet& rs, bool shadow) {
+    const size_t n = rs.size();
+    if (shadow) {
+        vis_.assign(n, 1.0f);
+    } else {
+        t_.resize(n);
+        hit_.assign(n, 0);
+        steps_.assign(n, 0);
+    }
+    const int max_steps = f_.max_steps;
+    constexpr int kBisect = 12;
+    const float inv_l = 1.0f / f_.raw_lipschitz;
+    run(
+        rs, [](Lanes& L, int i) { L.a[i] = -1.0f, L.sl[i] = 0.0f, L.om[i] = 0.0f; },
+        [&](Lanes& L, int m, const float* dist) {
+            for (int i = 0; i < m; ++i) {
+                const float s = L.sg[i] * dist[i], t = L.t[i], path = L.t0[i] + t;
+                const int st = ++L.steps[i];
+                bool done = false, hit = false;
+                if (L.sl[i] > 0.0f) {
+                    // Bisection: keep the outside end in b, the inside end in w.
+                    if (s < 0.0f) L.w[i] = t;
+                    else L.b[i] = t;
+                    L.sl[i] += 1.0f;
+                    if (L.sl[i] > kBisect || L.w[i] - L.b[i] < f_.thr(path)) {
+                        L.t[i] = L.b[i];
+                        done = hit = true;
+                    } else {
+                        L.t[i] = 0.5f * (L.b[i] + L.w[i]);
+                    }
+                } else if (s <= 0.0f) {  // a sign change (values are not distances: "close" means nothing)
+                    if (s == 0.0f || L.a[i] < 0.0f || shadow) {
+                        done = hit = true;
+                    } else {
+                        L.b[i] = L.a[i], L.w[i] = t, L.sl[i] = 1.0f;
+                        L.t[i] = 0.5f * (L.b[i] + L.w[i]);
+                    }
+                } else {
+                    const float step = s == s ? std::clamp(s * inv_l, f_.footprint(path), f_.raw_max_step) : f_.footprint(path);
+                    L.a[i] = t;
+                    L.t[i] = t + step;
+                    done = !(L.t[i] <= L.tmax[i]);
+                }
+                if (!done && st >= max_steps) {
+                    done = true;
+                    hit = L.sl[i] > 0.0f;  // inside a bracket: take its outside end
+                    if (hit) L.t[i] = L.b[i];
+                }
+                L.om[i] = hit ? 1.0f : 0.0f;
+                L.done[i] = done;
+            }
+        },
+        [&](Lanes& L, int i) {
+            const uint32_t r = L.ray[i];
+            if (shadow) {
+                vis_[r] = L.om[i] > 0.0f ? 0.0f : 1.0f;
+                return;
+            }
+            t_[r] = L.t[i];
+            hit_[r] = L.om[i] > 0.0f;
+            steps_[r] = L.steps[i];
+        },
+        [&](uint32_t r) {
+            if (!shadow) t_[r] = rs.tmax[r];
+        });
 }
 
 // Cone tracing of primary rays: fills ev_* (partial hits), t_/hit_ (final hit), trans_
@@ -470,12 +565,19 @@ void Worker::shadow_hard(const RaySet& rs) {
         rs, [](Lanes&, int) {},
         [&](Lanes& L, int m, const float* d) {
             for (int i = 0; i < m; ++i) {
+                // Over-relaxed like march(); a blocker only counts at a safe point.
+                const float r = std::fabs(d[i]);
+                const bool fail = (L.om[i] > 1.0f) & (r + L.pr[i] < L.sl[i]);
+                const float step = fail ? (1.0f - L.om[i]) * L.sl[i] : L.om[i] * d[i];
+                L.om[i] = fail ? 1.0f : L.om[i];
+                L.sl[i] = step;
+                L.pr[i] = r;
                 const float thr = eps * std::max(L.t0[i] + L.t[i], 1.0f);
                 const int st = ++L.steps[i];
-                const bool stop = (d[i] < thr) | (st >= max_steps);
-                const float tn = L.t[i] + d[i];
+                const bool stop = ((d[i] < thr) & !fail) | (st >= max_steps);
+                const float tn = L.t[i] + step;
                 const bool out = !(tn < L.tmax[i]);  // also NaN: no occluder found
-                L.a[i] = d[i];
+                L.a[i] = fail ? INFINITY : d[i];
                 L.t[i] = stop ? L.t[i] : tn;
                 L.done[i] = stop | out;
             }
@@ -597,7 +699,7 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
     const glm::vec3 amb = f_.ambient;
     if (max3(amb) > 0.0f) {
         ao_.assign(nl, 1.0f);
-        if (f_.ao) {
+        if (f_.ao && !f_.raw) {
             px_.resize(nl * kAoTaps), py_.resize(nl * kAoTaps), pz_.resize(nl * kAoTaps), pd_.resize(nl * kAoTaps);
             for (size_t k = 0; k < nl; ++k) {
                 const glm::vec3 P = h.o(local_[k]);
@@ -614,7 +716,7 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
                 for (int j = 0; j < kAoTaps; ++j) {
                     const float s = 0.01f + 0.12f * static_cast<float>(j) / (kAoTaps - 1);
                     const float d = pd_[k * kAoTaps + j];
-                    if (d == d) occ += (s - std::min(d, s + 1.0f)) * sca;
+                    if (d < s) occ += (s - d) * sca;  // (NaN adds nothing)
                     sca *= 0.95f;
                 }
                 ao_[k] = clamp01(1.0f - 3.0f * occ);
@@ -676,7 +778,8 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
             sw_.push_back(light.directional ? light.radius : light.radius / dist);
         }
         if (shadow_.size() == 0) continue;
-        if (light.radius > 0.0f) shadow_soft(shadow_);
+        if (f_.raw) march_raw(shadow_, true);
+        else if (light.radius > 0.0f) shadow_soft(shadow_);
         else shadow_hard(shadow_);
         for (size_t s = 0; s < shadow_.size(); ++s)
             if (vis_[s] > 0.0f) add(shadow_.prim[s], glm::vec3(lrad_[s * 3], lrad_[s * 3 + 1], lrad_[s * 3 + 2]) * vis_[s]);
@@ -815,6 +918,46 @@ void Worker::render_tile_2d(int x0, int y0, int x1, int y1, Image& img, AovPlane
         }
 }
 
+// A Lipschitz estimate for a raw field over a box: the largest gradient norm (forward
+// differences) on a 16^3 grid, among the tenth of the points with the smallest |f| (the far
+// field of e.g. a polynomial grows much faster than near its surface, where steps matter),
+// times 1.5.
+float estimate_lipschitz(const CompiledScene& scene, const glm::vec3& lo, const glm::vec3& hi) {
+    constexpr int kGrid = 16;
+    Evaluator ev(scene.distance);
+    const glm::vec3 ext = hi - lo;
+    if (!std::isfinite(max3(ext))) return 1.0f;
+    const float e = 1e-3f * std::max(max3(ext), 1e-6f);
+    std::vector<float> fx, fy, fz, value, grad;
+    for (int k = 0; k < kGrid; ++k)
+        for (int j = 0; j < kGrid; ++j)
+            for (int i = 0; i < kGrid; ++i) {
+                const glm::vec3 p = lo + ext * (glm::vec3(i, j, k) + 0.5f) / static_cast<float>(kGrid);
+                for (int q = 0; q < 4; ++q) {
+                    fx.push_back(p.x + (q == 1 ? e : 0.0f));
+                    fy.push_back(p.y + (q == 2 ? e : 0.0f));
+                    fz.push_back(p.z + (q == 3 ? e : 0.0f));
+                }
+            }
+    std::vector<float> out(fx.size());
+    for (size_t i = 0; i < fx.size(); i += kBatch) {
+        const int m = static_cast<int>(std::min<size_t>(kBatch, fx.size() - i));
+        ev.eval(fx.data() + i, fy.data() + i, fz.data() + i, m, scene.time);
+        std::copy_n(ev.output(0), m, out.data() + i);
+    }
+    std::vector<std::pair<float, float>> samples;  // (|f|, |grad f|)
+    for (size_t i = 0; i + 3 < out.size(); i += 4) {
+        const glm::vec3 g(out[i + 1] - out[i], out[i + 2] - out[i], out[i + 3] - out[i]);
+        const float gn = glm::length(g) / e;
+        if (std::isfinite(gn) && std::isfinite(out[i])) samples.emplace_back(std::fabs(out[i]), gn);
+    }
+    if (samples.empty()) return 1.0f;
+    std::sort(samples.begin(), samples.end());
+    float l = 0.0f;
+    for (size_t i = 0; i < (samples.size() + 9) / 10; ++i) l = std::max(l, samples[i].second);
+    return l > 1e-6f ? 1.5f * l : 1.0f;
+}
+
 }  // namespace
 
 Image render(const CompiledScene& scene, const RenderOptions& options, RenderStats* stats) {
@@ -836,13 +979,29 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
     f.background = glm::vec3(nonneg(scene.background.x), nonneg(scene.background.y), nonneg(scene.background.z));
     f.has_distance = !scene.distance.outputs.empty();
     f.has_material = scene.shading.outputs.size() >= static_cast<size_t>(1 + kMatOut);
-    if (scene.bounds.finite()) {
+    f.raw = scene.raw_field && f.has_distance;
+    if (f.raw) {
+        f.cone = false;
+        f.samples = std::clamp(rs.samples, 1, 4096);
+    }
+    if (f.raw && !scene.bounds.finite()) {
+        // No bounds and no distance: march within the cube around the camera's target whose
+        // half-size is the camera's distance to it (a .vm model's default view frames it).
+        const float r = std::max(glm::length(scene.camera.position - scene.camera.target), 1.0f);
+        f.lo = scene.camera.target - glm::vec3(r);
+        f.hi = scene.camera.target + glm::vec3(r);
+        f.clip = std::isfinite(r);
+    } else if (scene.bounds.finite()) {
         // A little slack so rays start outside the surface's tolerance band.
         const glm::vec3 ext = scene.bounds.hi - scene.bounds.lo;
         const glm::vec3 margin = glm::vec3(1e-3f * std::max(max3(ext), 0.0f) + 1e-3f);
         f.lo = scene.bounds.lo - margin;
         f.hi = scene.bounds.hi + margin;
         f.clip = f.lo.x <= f.hi.x && f.lo.y <= f.hi.y && f.lo.z <= f.hi.z;
+    }
+    if (f.raw) {
+        f.raw_lipschitz = estimate_lipschitz(scene, f.lo, f.hi);
+        f.raw_max_step = f.clip ? glm::length(f.hi - f.lo) / 48.0f : 0.05f * f.max_dist;
     }
     for (int i = 0; i < f.samples; ++i) {
         const float sx = (static_cast<float>(i) + 0.5f) / static_cast<float>(f.samples);

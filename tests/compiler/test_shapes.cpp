@@ -71,7 +71,7 @@ TEST_CASE("box_frame: distance to the edges only") {
     CHECK(close(dist_of("box_frame(2, 0.1);", 2, 1, 1), 1));  // outside a corner edge, straight out
     check_random("box_frame([2, 2, 2], 0.1);", [](dv3 p) {
         dv3 b{1, 1, 1};
-        double e = 0.1;
+        double e = 0.05;  // half the bar thickness
         p = glm::abs(p) - b;
         dv3 q = glm::abs(p + e) - e;
         auto f = [](dv3 v) { return glm::length(glm::max(v, 0.0)) + std::min(std::max(v.x, std::max(v.y, v.z)), 0.0); };
@@ -165,7 +165,7 @@ TEST_CASE("ellipsoid: exact on the axes, a bound elsewhere") {
     float d = dist_of("ellipsoid([2, 1, 1]);", 3, 0, 0);
     CHECK(d > 0);
     CHECK(d <= 1.0f + 1e-5f);
-    CHECK(dist_of("ellipsoid([2, 1, 1]);", 0, 0, 0) < 0);
+    CHECK(dist_of("ellipsoid([2, 1, 1]);", 0.5, 0, 0) < 0);
 }
 
 TEST_CASE("octahedron: exact") {
@@ -177,6 +177,7 @@ TEST_CASE("octahedron: exact") {
 TEST_CASE("pyramid: base 1x1 on y = 0, apex at h") {
     CHECK(close(dist_of("pyramid(1);", 0, 2, 0), 1));     // above the apex
     CHECK(close(dist_of("pyramid(1);", 0, -1, 0), 1));    // below the base
+    CHECK(close(dist_of("pyramid(1);", 1, -1, 0), std::sqrt(1.25)));  // below a base edge
     CHECK(close(dist_of("pyramid(1);", 1.5, 0, 0), 1.0));   // beside the base edge
     CHECK(dist_of("pyramid(1);", 0, 0.2, 0) < 0);
 }

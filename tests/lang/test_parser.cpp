@@ -565,9 +565,16 @@ TEST_CASE("locations", "[parser]") {
     CHECK(assign.loc.line == 3);
     CHECK(assign.name_loc.col == 1);
     const Expr& mul = *assign.value;
-    CHECK(mul.loc.col == 5);        // the '(' of the first operand
-    CHECK(mul.lhs->loc.col == 6);   // the sum itself starts after it
+    CHECK(mul.loc.col == 13);       // a binary operation: its operator
+    CHECK(mul.lhs->loc.col == 8);
     CHECK(mul.rhs->loc.col == 15);
+    CHECK(assign.value->kind == ExprKind::Binary);
+    Parsed q = parse_text("(a + b) * c ? x : y;\n(a).x;\n(f)(1);");
+    CHECK(q.stmt(0).loc.col == 1);          // statements start at the '('
+    CHECK(q.stmt(0).value->loc.col == 1);   // and so does the ternary (its first character)
+    CHECK(q.stmt(1).value->loc.col == 1);   // the swizzle
+    CHECK(q.stmt(2).value->loc.col == 1);   // the call: its callee's first character
+    CHECK(error_of("(m) box(1);") == "1:4: expected ';' after the statement");  // modifiers are names or calls
     const Expr& fgh = *p.stmt(3).value;
     CHECK(fgh.loc.line == 4);
     CHECK(fgh.loc.col == 3);

@@ -311,6 +311,34 @@ TEST_CASE("render: steps view is a heat map of the step counts", "[render][aov]"
     CHECK(px(img, 32, 24) != px(render(s, {}), 32, 24));
 }
 
+TEST_CASE("render: raw fields (no distance bound) are marched by sign", "[render][raw]") {
+    Builder b;
+    // Ten times a sphere's distance: sphere tracing would step 10x too far and miss.
+    NodeId f = b.g.mulc(b.sphere({0, 0, 0}, 1), 10.0f);
+    // Plus a sheet where the field comes within 1e-5 of zero without crossing it (at z = 0.5,
+    // away from the sphere): not a surface.
+    NodeId sheet = b.g.addc(b.g.abs(b.g.addc(b.z, -0.5f)), 1e-5f);
+    CompiledScene s = red_sphere(b);
+    s.distance = codegen(b.g, {f}, {"d"});
+    Image traced = render(s, {});
+    CHECK(px(traced, 32, 24) == s.background);  // overshoots, as expected of sphere tracing
+    s.distance = codegen(b.g, {b.g.min(f, sheet)}, {"d"});
+    s.raw_field = true;
+    Image raw = render(s, {});
+    CHECK(all_finite(raw));
+    glm::vec3 centre = px(raw, 32, 24);
+    CHECK(centre.r > 0.3f);
+    CHECK(centre.r > 4.0f * centre.g);
+    CHECK(px(raw, 0, 0) == s.background);
+    RenderOptions o;
+    o.aovs = {"depth"};
+    CHECK(render(s, o).aov("depth")->data[24 * 64 + 32] == Approx(4.0f).margin(0.01f));
+    // Identical for any thread count here too.
+    RenderOptions o1, o2;
+    o1.threads = 1, o2.threads = 2;
+    CHECK(render(s, o1).pixels == render(s, o2).pixels);
+}
+
 TEST_CASE("render: 2D models render as the Prospero image", "[render][2d]") {
     Builder b;
     NodeId disc = b.g.sub(b.g.binary(Op::Length2, b.x, b.y), b.c(0.5f));

@@ -1,0 +1,502 @@
+// The GLSL twin of the CPU renderer (runtime/camera.cpp + runtime/tracer.cpp), pasted after
+// the scene functions by compiler/glsl.cpp. Same camera, marching rules, tetrahedral normals,
+// materials sanitising, Blinn-Phong, hard/soft shadows, AO, mirror/glass bounces (an
+// explicit stack instead of the CPU's ray wavefronts: GLSL has no recursion), background,
+// sRGB. Keep the two in step: tests/gpu compares the pictures.
+//
+// It expects, defined before it (compiler/glsl.cpp writes them from the scene):
+//   const int SDF_MAX_STEPS, SDF_MAX_BOUNCES, SDF_SAMPLES, SDF_NUM_LIGHTS;
+//   const float SDF_MAX_DIST, SDF_EPSILON, SDF_MIN_WEIGHT, SDF_SAMPLE_WEIGHT;
+//   const bool SDF_SHADOWS, SDF_AO, SDF_CONE, SDF_2D, SDF_CLIP, SDF_DEFAULT_LIGHTS, SDF_ORTHO;
+//   const vec3 SDF_LO, SDF_HI; const vec2 SDF_OFFSETS[SDF_SAMPLES];
+//   float map(vec3 p); Material sdf_material(vec3 p); void sdf_settings();
+//   and the globals below that sdf_settings() assigns.
+#pragma once
+
+namespace sdfc::glsl {
+
+// Declarations the generated scene code needs (before map/sdf_material/sdf_settings).
+inline constexpr const char* kRendererHead = R"(// The 11 material channels of a surface point.
+struct Material {
+    vec3 color;
+    float specular;
+    float shininess;
+    float reflectance;   // mirror part, 0..1
+    float transparency;  // glass part, 0..1
+    float ior;
+    vec3 emission;
+};
+
+struct SdfLight {
+    bool directional;
+    vec3 position;   // point lights
+    vec3 direction;  // directional lights: where the light travels
+    vec3 color;
+    float intensity;
+    float radius;    // > 0: soft shadows
+};
+
+// Scene settings, assigned by sdf_settings() (they may depend on the time).
+float sdf_time;
+vec3 sdf_cam_position, sdf_cam_target, sdf_cam_up;
+float sdf_cam_fov, sdf_cam_ortho_height;
+SdfLight sdf_lights[SDF_NUM_LIGHTS];
+vec3 sdf_ambient, sdf_background;
+)";
+
+inline constexpr const char* kRendererBody = R"(
+// ---------------------------------------------------------------------------------------
+// The renderer: a line-by-line twin of sdfc's CPU renderer (runtime/tracer.cpp).
+// ---------------------------------------------------------------------------------------
+
+float sdf_inf() { return uintBitsToFloat(0x7f800000u); }
+bool sdf_finite(float v) { return !isnan(v) && !isinf(v); }
+bool sdf_finite3(vec3 v) { return sdf_finite(v.x) && sdf_finite(v.y) && sdf_finite(v.z); }
+float sdf_max3(vec3 v) { return max(v.x, max(v.y, v.z)); }
+float sdf_maxabs3(vec3 v) { return max(abs(v.x), max(abs(v.y), abs(v.z))); }
+float sdf_nonneg(float v) { return v > 0.0 ? (sdf_finite(v) ? v : 1e30) : 0.0; }
+float sdf_clamp01(float v) { return v > 0.0 ? (v < 1.0 ? v : 1.0) : 0.0; }
+
+// Camera (runtime/camera.cpp).
+vec3 sdf_eye, sdf_fwd, sdf_right, sdf_up;
+float sdf_half_w, sdf_half_h, sdf_inv_w, sdf_inv_h, sdf_foot_base, sdf_foot_slope;
+
+void sdf_setup_camera(vec3 position, vec3 target, vec3 up_in, float fov_in, float ortho_height, vec2 res) {
+    float width = max(res.x, 1.0), height = max(res.y, 1.0);
+    sdf_eye = sdf_finite3(position) ? position : vec3(0.0, 0.0, 5.0);
+    vec3 f = target - sdf_eye;
+    sdf_fwd = (sdf_finite3(f) && dot(f, f) > 1e-20) ? normalize(f) : vec3(0.0, 0.0, -1.0);
+    vec3 up = (sdf_finite3(up_in) && dot(up_in, up_in) > 1e-20) ? normalize(up_in) : vec3(0.0, 1.0, 0.0);
+    vec3 r = cross(sdf_fwd, up);
+    if (dot(r, r) < 1e-12) {
+        up = abs(sdf_fwd.y) < 0.9 ? vec3(0.0, 1.0, 0.0) : vec3(0.0, 0.0, 1.0);
+        r = cross(sdf_fwd, up);
+    }
+    sdf_right = normalize(r);
+    sdf_up = cross(sdf_right, sdf_fwd);
+    float aspect = width / height;
+    if (SDF_ORTHO) {
+        float h = (sdf_finite(ortho_height) && ortho_height > 0.0) ? ortho_height : 2.0;
+        sdf_half_h = 0.5 * h;
+        sdf_half_w = sdf_half_h * aspect;
+        sdf_foot_base = 0.70710678 * h / height;
+        sdf_foot_slope = 0.0;
+    } else {
+        float fov = sdf_finite(fov_in) ? clamp(fov_in, 1e-3, 179.0) : 45.0;
+        sdf_half_h = tan(0.5 * radians(fov));
+        sdf_half_w = sdf_half_h * aspect;
+        sdf_foot_base = 0.0;
+        sdf_foot_slope = 0.70710678 * 2.0 * sdf_half_h / height;
+    }
+    sdf_inv_w = 1.0 / width;
+    sdf_inv_h = 1.0 / height;
+}
+
+// The ray through image point (px, py) in pixels, row 0 at the top.
+void sdf_camera_ray(float px, float py, out vec3 o, out vec3 d) {
+    float u = (2.0 * px * sdf_inv_w - 1.0) * sdf_half_w;
+    float v = (1.0 - 2.0 * py * sdf_inv_h) * sdf_half_h;
+    if (SDF_ORTHO) {
+        o = sdf_eye + u * sdf_right + v * sdf_up;
+        d = sdf_fwd;
+    } else {
+        o = sdf_eye;
+        d = normalize(sdf_fwd + u * sdf_right + v * sdf_up);
+    }
+}
+
+// Interactive camera: orbit = (yaw, pitch, zoom, on), pan in units of the orbit radius.
+// Turns the script's camera around its target (about its up vector); off: the script's view.
+void sdf_orbit(inout vec3 pos, inout vec3 target, vec3 up_in, vec4 orbit, vec2 pan) {
+    vec3 up = dot(up_in, up_in) > 1e-20 ? normalize(up_in) : vec3(0.0, 1.0, 0.0);
+    vec3 off = pos - target;
+    float r = length(off);
+    if (!(r > 1e-6) || !sdf_finite(r)) { off = vec3(0.0, 0.0, 1.0); r = 1.0; }
+    vec3 dir = off / r;
+    vec3 h = dir - up * dot(dir, up);
+    vec3 e1 = dot(h, h) > 1e-8 ? normalize(h) : normalize(cross(up, abs(up.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 0.0, 1.0)));
+    vec3 e2 = cross(up, e1);
+    float el = clamp(asin(clamp(dot(dir, up), -1.0, 1.0)) + orbit.y, -1.5, 1.5);
+    vec3 nd = cos(el) * (cos(orbit.x) * e1 + sin(orbit.x) * e2) + sin(el) * up;
+    float rr = r * max(orbit.z, 1e-4);
+    vec3 right = normalize(cross(-nd, up));
+    vec3 vup = cross(right, -nd);
+    target += (right * pan.x + vup * pan.y) * rr;
+    pos = target + nd * rr;
+}
+
+// Shadertoy's iMouse (xy: current, zw: where the button went down, z > 0 while down) as an
+// orbit: dragging turns the camera; released, the script's camera is used.
+vec4 sdf_mouse_orbit(vec4 mouse, vec2 res) {
+    if (mouse.z <= 0.0) return vec4(0.0);
+    vec2 d = (mouse.xy - abs(mouse.zw)) / max(res, vec2(1.0));
+    return vec4(-6.2831853 * d.x, -3.1415927 * d.y, 1.0, 1.0);
+}
+
+float sdf_thr(float path) { return SDF_EPSILON * max(path, 1.0); }
+float sdf_footprint(float path) { return sdf_foot_base + sdf_foot_slope * path; }
+float sdf_bias(vec3 p, float path) { return 4.0 * sdf_thr(path) + 2e-5 * (1.0 + sdf_maxabs3(p)); }
+
+// Clips [t_min, t_max] to the scene's bounding box; an empty interval gets t_min = inf.
+void sdf_clip_ray(vec3 o, vec3 d, inout float t_min, inout float t_max) {
+    if (!SDF_CLIP) return;
+    for (int a = 0; a < 3; ++a) {
+        if (abs(d[a]) < 1e-30) {
+            if (o[a] < SDF_LO[a] || o[a] > SDF_HI[a]) t_min = sdf_inf();
+            continue;
+        }
+        float inv = 1.0 / d[a];
+        float t1 = (SDF_LO[a] - o[a]) * inv, t2 = (SDF_HI[a] - o[a]) * inv;
+        if (t1 > t2) { float s = t1; t1 = t2; t2 = s; }
+        t_min = max(t_min, t1);
+        t_max = min(t_max, t2);
+    }
+    if (!(t_min <= t_max)) t_min = sdf_inf();
+}
+
+// Sphere tracing (on -d inside a solid). Hit when d < epsilon * max(path, 1); a ray out of
+// steps hits when within one pixel footprint.
+bool sdf_march(vec3 o, vec3 d, float tmin, float tmax, float t0, bool inside, out float t) {
+    t = tmin;
+    if (!(t <= tmax)) { t = tmax; return false; }
+    for (int steps = 1; steps <= SDF_MAX_STEPS; ++steps) {
+        float dist = map(o + t * d);
+        float s = inside ? -dist : dist;
+        float path = t0 + t;
+        if (s < sdf_thr(path)) return true;
+        if (isnan(s)) return false;
+        if (steps >= SDF_MAX_STEPS) return s < sdf_footprint(path);
+        t += s;
+        if (!(t <= tmax)) return false;
+    }
+    return false;
+}
+
+// Cone tracing of a primary ray (render(aa = "cone")): up to 4 partial hits at edges.
+bool sdf_cone_march(vec3 o, vec3 d, float tmin, float tmax, out float t, out float ev_t[4], out float ev_w[4],
+                    out int ev_n, out float trans) {
+    ev_n = 0;
+    trans = 1.0;
+    for (int e = 0; e < 4; ++e) { ev_t[e] = 0.0; ev_w[e] = 0.0; }
+    t = tmin;
+    if (!(t <= tmax)) { t = tmax; return false; }
+    float a = 2.0, b = 0.0;
+    for (int steps = 1; steps <= SDF_MAX_STEPS; ++steps) {
+        float dist = map(o + t * d);
+        float path = t;
+        float radius = max(sdf_footprint(path), 1e-30);
+        if (dist < sdf_thr(path)) return true;
+        if (isnan(dist)) return false;
+        bool done = false, hit = false;
+        float rho = dist / radius;
+        if (rho < 1.0) {
+            if (rho < a) { a = rho; b = t; }
+        } else if (a < 1.0) {
+            float cov = 1.0 - a;
+            if (ev_n < 4 && cov > 0.0) { ev_t[ev_n] = b; ev_w[ev_n] = trans * cov; trans *= 1.0 - cov; ++ev_n; }
+            a = 2.0;
+        }
+        if (trans < 1e-3) {
+            done = true;
+        } else if (steps >= SDF_MAX_STEPS) {
+            done = true;
+            hit = dist < radius;
+        } else {
+            t += dist;
+            if (!(t <= tmax)) done = true;
+        }
+        if (done && !hit && a < 1.0) {
+            float cov = 1.0 - a;
+            if (ev_n < 4 && cov > 0.0) { ev_t[ev_n] = b; ev_w[ev_n] = trans * cov; trans *= 1.0 - cov; ++ev_n; }
+        }
+        if (done) return hit;
+    }
+    return false;
+}
+
+// Tetrahedron normal; a flat or broken field faces the viewer.
+vec3 sdf_normal(vec3 p, float path, vec3 dir) {
+    float e = max(sdf_thr(path), 2e-5 * (1.0 + sdf_maxabs3(p)));
+    vec3 g = vec3(0.0);
+    for (int k = 0; k < 4; ++k) {
+        vec3 kk = k == 0 ? vec3(1.0, -1.0, -1.0) : (k == 1 ? vec3(-1.0, -1.0, 1.0) : (k == 2 ? vec3(-1.0, 1.0, -1.0) : vec3(1.0)));
+        g += kk * map(p + e * kk);
+    }
+    float len2 = dot(g, g);
+    if (len2 > 1e-30 && sdf_finite(len2)) return g * (1.0 / sqrt(len2));
+    return -dir;
+}
+
+// The material at p, sanitised (no NaN/inf, sensible ranges).
+Material sdf_surface(vec3 p) {
+    Material m = sdf_material(p);
+    m.color = vec3(sdf_nonneg(m.color.x), sdf_nonneg(m.color.y), sdf_nonneg(m.color.z));
+    m.specular = sdf_nonneg(m.specular);
+    m.emission = vec3(sdf_nonneg(m.emission.x), sdf_nonneg(m.emission.y), sdf_nonneg(m.emission.z));
+    m.shininess = sdf_finite(m.shininess) ? clamp(m.shininess, 0.0, 1e4) : 32.0;
+    m.reflectance = sdf_clamp01(m.reflectance);
+    m.transparency = sdf_clamp01(m.transparency);
+    m.ior = (sdf_finite(m.ior) && m.ior > 1e-3) ? m.ior : 1.5;
+    return m;
+}
+
+float sdf_schlick(float cos_theta, float ior) {
+    float r0 = (ior - 1.0) / (ior + 1.0);
+    r0 *= r0;
+    float m = 1.0 - sdf_clamp01(cos_theta);
+    float m2 = m * m;
+    return r0 + (1.0 - r0) * m2 * m2 * m;
+}
+
+float sdf_penumbra(float res) {
+    res = clamp(res, -1.0, 1.0);
+    return 0.25 * (1.0 + res) * (1.0 + res) * (2.0 - res);
+}
+
+// Visibility of a light along [tmin, tmax]: hard (any hit = 0) or, with a light radius
+// (angular width w), Quilez's soft penumbra with the closest-approach refinement.
+float sdf_shadow(vec3 o, vec3 l, float tmin, float tmax, float t0, float w, bool soft) {
+    float t = tmin;
+    if (!(t <= tmax)) return 1.0;
+    float res = 1.0, prev = 1e20;
+    for (int steps = 1; steps <= SDF_MAX_STEPS; ++steps) {
+        float h = map(o + t * l);
+        float path = t0 + t;
+        if (!soft) {
+            if (h < sdf_thr(path)) return 0.0;
+            if (isnan(h)) return 1.0;
+            if (steps >= SDF_MAX_STEPS) return h < sdf_footprint(path) ? 0.0 : 1.0;
+            t += h;
+            if (!(t < tmax)) return 1.0;
+        } else {
+            if (isnan(h)) return sdf_penumbra(res);
+            float est;
+            if (h > 0.0) {
+                float y = min(h * h / (2.0 * prev), 0.999 * h);
+                float dd = sqrt(h * h - y * y);
+                est = dd / (w * max(t - y, 1e-20));
+                prev = h;
+            } else {
+                est = h / (w * max(t, 1e-20));
+                prev = 1e20;
+            }
+            res = min(res, est);
+            if (res <= -1.0 || steps >= SDF_MAX_STEPS) return sdf_penumbra(res);
+            t += h > 0.0 ? max(h, sdf_thr(path)) : max(0.25 * w * t, sdf_thr(path));
+            if (!(t < tmax)) return sdf_penumbra(res);
+        }
+    }
+    return 1.0;
+}
+
+float sdf_pow(float x, float y) {
+    if (y == 0.0) return 1.0;
+    return x > 0.0 ? pow(x, y) : 0.0;
+}
+
+// Ambient (with occlusion) and direct light at a surface point of local weight lw.
+vec3 sdf_local_light(vec3 P, vec3 D, vec3 N, float path, Material m, vec3 lw) {
+    vec3 acc = vec3(0.0);
+    if (sdf_max3(sdf_ambient) > 0.0) {
+        float ao = 1.0;
+        if (SDF_AO) {
+            float occ = 0.0, sca = 1.0;
+            for (int j = 0; j < 5; ++j) {
+                float s = 0.01 + 0.12 * float(j) / 4.0;
+                float d = map(P + N * s);
+                if (!isnan(d)) occ += (s - min(d, s + 1.0)) * sca;
+                sca *= 0.95;
+            }
+            ao = sdf_clamp01(1.0 - 3.0 * occ);
+        }
+        acc += lw * m.color * sdf_ambient * ao;
+    }
+    for (int i = 0; i < SDF_NUM_LIGHTS; ++i) {
+        SdfLight li = sdf_lights[i];
+        vec3 radiance = li.color * li.intensity;
+        float rmax = sdf_max3(radiance);
+        if (!(rmax > 0.0) || !sdf_finite(rmax)) continue;
+        vec3 L = -li.direction;
+        float dist = SDF_MAX_DIST, falloff = 1.0;
+        if (li.directional) {
+            if (!(dot(L, L) > 0.0)) continue;
+            L = normalize(L);
+        } else {
+            L = li.position - P;
+            dist = length(L);
+            if (!(dist > 1e-6)) continue;
+            L /= dist;
+            falloff = 1.0 / (dist * dist);
+        }
+        float ndl = dot(N, L);
+        if (!(ndl > 0.0)) continue;
+        vec3 H = normalize(L - D);
+        float ndh = max(dot(N, H), 0.0);
+        float spec = m.specular > 0.0 ? m.specular * sdf_pow(ndh, m.shininess) : 0.0;
+        vec3 c = lw * radiance * falloff * (m.color * ndl + spec);
+        if (!SDF_SHADOWS) { acc += c; continue; }
+        float bias = sdf_bias(P, path);
+        vec3 o = P + N * bias;
+        float tmin = 0.0, tmax = li.directional ? SDF_MAX_DIST : max(dist - bias, 0.0);
+        sdf_clip_ray(o, L, tmin, tmax);
+        if (!(tmin <= tmax)) { acc += c; continue; }
+        float vis = sdf_shadow(o, L, tmin, tmax, path, li.directional ? li.radius : li.radius / dist, li.radius > 0.0);
+        if (vis > 0.0) acc += c * vis;
+    }
+    return acc;
+}
+
+// Settings the CPU compiler resolves (compiler/compile.cpp): light directions normalised,
+// the default two-light rig when the script has no light.
+void sdf_init_scene() {
+    if (!SDF_DEFAULT_LIGHTS) {
+        for (int i = 0; i < SDF_NUM_LIGHTS; ++i)
+            if (sdf_lights[i].directional) {
+                vec3 d = sdf_lights[i].direction;
+                sdf_lights[i].direction = length(d) > 0.0 ? normalize(d) : vec3(0.0, -1.0, 0.0);
+            }
+    } else {
+        vec3 fwd = normalize(sdf_cam_target - sdf_cam_position);
+        vec3 right = normalize(cross(fwd, sdf_cam_up));
+        vec3 up = normalize(sdf_cam_up);
+        sdf_lights[0] = SdfLight(true, vec3(0.0), normalize(fwd + 0.6 * right - 1.2 * up), vec3(1.0, 0.97, 0.92), 1.0, 0.0);
+        sdf_lights[1] = SdfLight(true, vec3(0.0), normalize(fwd - 0.8 * right - 0.3 * up), vec3(0.55, 0.6, 0.7), 0.35, 0.0);
+    }
+    sdf_ambient = vec3(sdf_nonneg(sdf_ambient.x), sdf_nonneg(sdf_ambient.y), sdf_nonneg(sdf_ambient.z));
+    sdf_background = vec3(sdf_nonneg(sdf_background.x), sdf_nonneg(sdf_background.y), sdf_nonneg(sdf_background.z));
+}
+
+// A ray waiting to be traced (or, with known = true, a hit already found at thit).
+struct SdfRay {
+    vec3 o, d, w;
+    float tmin, tmax, t0, thit;
+    bool inside, known;
+    int gen;
+};
+const int SDF_STACK = SDF_MAX_BOUNCES + 6;
+
+// One primary sample of weight w0: the first hit, then mirror/glass bounces depth first.
+vec3 sdf_trace(vec3 O, vec3 D, float w0) {
+    vec3 acc = vec3(0.0);
+    SdfRay stack[SDF_STACK];
+    int sp = 0;
+    float tmin = 0.0, tmax = SDF_MAX_DIST;
+    sdf_clip_ray(O, D, tmin, tmax);
+    float t;
+    if (SDF_CONE) {
+        float ev_t[4], ev_w[4], trans;
+        int ev_n;
+        bool hit = sdf_cone_march(O, D, tmin, tmax, t, ev_t, ev_w, ev_n, trans);
+        for (int e = 0; e < 4; ++e)
+            if (e < ev_n) stack[sp++] = SdfRay(O, D, vec3(ev_w[e] * w0), 0.0, 0.0, 0.0, ev_t[e], false, true, 0);
+        float rest = trans * w0;
+        if (hit) stack[sp++] = SdfRay(O, D, vec3(rest), 0.0, 0.0, 0.0, t, false, true, 0);
+        else acc += sdf_background * rest;
+    } else {
+        if (sdf_march(O, D, tmin, tmax, 0.0, false, t)) stack[sp++] = SdfRay(O, D, vec3(w0), 0.0, 0.0, 0.0, t, false, true, 0);
+        else acc += sdf_background * w0;
+    }
+    for (int guard = 0; guard < 4096 && sp > 0; ++guard) {
+        SdfRay r = stack[--sp];
+        t = r.thit;
+        if (!r.known) {
+            if (!sdf_march(r.o, r.d, r.tmin, r.tmax, r.t0, r.inside, t)) {
+                if (!r.inside) acc += sdf_background * r.w;
+                continue;
+            }
+        }
+        vec3 P = r.o + r.d * t;
+        float path = r.t0 + t;
+        vec3 Dr = r.d;
+        vec3 N = sdf_normal(P, path, Dr);
+        vec3 Nf = dot(Dr, N) > 0.0 ? -N : N;
+        Material m = sdf_surface(P);
+        bool can_spawn = r.gen < SDF_MAX_BOUNCES;
+        float bias = sdf_bias(P, path);
+        if (r.inside) {
+            // Leaving a transparent solid: refract out, reflect back in (Fresnel / TIR).
+            if (!can_spawn) continue;
+            vec3 T = refract(Dr, Nf, m.ior);
+            float F = 1.0;
+            if (dot(T, T) > 0.0) F = sdf_schlick(-dot(T, Nf), m.ior);
+            vec3 wr = r.w * F, wt = r.w * (1.0 - F);
+            if (sdf_max3(wr) >= SDF_MIN_WEIGHT && sp < SDF_STACK) {
+                vec3 o = P + Nf * bias, d = reflect(Dr, Nf);
+                float a = 0.0, b = SDF_MAX_DIST;
+                sdf_clip_ray(o, d, a, b);
+                stack[sp++] = SdfRay(o, d, wr, a, b, path, 0.0, true, false, r.gen + 1);
+            }
+            if (sdf_max3(wt) >= SDF_MIN_WEIGHT && sp < SDF_STACK) {
+                vec3 o = P - Nf * bias, d = normalize(T);
+                float a = 0.0, b = SDF_MAX_DIST;
+                sdf_clip_ray(o, d, a, b);
+                stack[sp++] = SdfRay(o, d, wt, a, b, path, 0.0, false, false, r.gen + 1);
+            }
+            continue;
+        }
+        acc += r.w * m.emission;
+        float refl = can_spawn ? m.reflectance : 0.0;
+        float tr = can_spawn ? m.transparency : 0.0;
+        vec3 lw = r.w * ((1.0 - refl) * (1.0 - tr));
+        if (sdf_max3(lw) > 0.0) acc += sdf_local_light(P, Dr, Nf, path, m, lw);
+        if (!can_spawn) continue;
+        vec3 w_refl = r.w * refl;
+        if (tr > 0.0) {
+            vec3 base = r.w * ((1.0 - refl) * tr);
+            vec3 T = refract(Dr, Nf, 1.0 / m.ior);
+            float F = 1.0;
+            if (dot(T, T) > 0.0) F = sdf_schlick(-dot(Dr, Nf), m.ior);
+            w_refl += base * F;
+            vec3 wt = base * (1.0 - F) * m.color;
+            if (sdf_max3(wt) >= SDF_MIN_WEIGHT && sp < SDF_STACK) {
+                vec3 o = P - Nf * bias, d = normalize(T);
+                float a = 0.0, b = SDF_MAX_DIST;
+                sdf_clip_ray(o, d, a, b);
+                stack[sp++] = SdfRay(o, d, wt, a, b, path, 0.0, true, false, r.gen + 1);
+            }
+        }
+        if (sdf_max3(w_refl) >= SDF_MIN_WEIGHT && sp < SDF_STACK) {
+            vec3 o = P + Nf * bias, d = reflect(Dr, Nf);
+            float a = 0.0, b = SDF_MAX_DIST;
+            sdf_clip_ray(o, d, a, b);
+            stack[sp++] = SdfRay(o, d, w_refl, a, b, path, 0.0, false, false, r.gen + 1);
+        }
+    }
+    return acc;
+}
+
+float sdf_to_srgb(float v) {
+    if (!(v > 0.0)) return 0.0;
+    if (v >= 1.0) return 1.0;
+    return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+}
+
+// The picture at fragCoord (GL convention: origin at the bottom left) for a res-sized
+// viewport at `time`, with an optional interactive orbit (see sdf_orbit).
+vec4 sdf_render(vec2 frag_coord, vec2 res, float time, vec4 orbit, vec2 pan) {
+    sdf_time = time;
+    sdf_settings();
+    sdf_init_scene();
+    float x = floor(frag_coord.x), row = floor(res.y) - 1.0 - floor(frag_coord.y);
+    if (SDF_2D) {
+        // A 2D model: W x H samples over [-1, 1]^2 including both ends, white inside.
+        float sx = res.x > 1.0 ? 2.0 / (floor(res.x) - 1.0) : 0.0;
+        float sy = res.y > 1.0 ? 2.0 / (floor(res.y) - 1.0) : 0.0;
+        float v = map(vec3(-1.0 + sx * x, 1.0 - sy * row, 0.0)) < 0.0 ? 1.0 : 0.0;
+        return vec4(vec3(v), 1.0);
+    }
+    vec3 pos = sdf_cam_position, target = sdf_cam_target;
+    if (orbit.w > 0.0) sdf_orbit(pos, target, sdf_cam_up, orbit, pan);
+    sdf_setup_camera(pos, target, sdf_cam_up, sdf_cam_fov, sdf_cam_ortho_height, floor(res));
+    vec3 acc = vec3(0.0);
+    for (int s = 0; s < SDF_SAMPLES; ++s) {
+        vec3 o, d;
+        sdf_camera_ray(x + SDF_OFFSETS[s].x, row + SDF_OFFSETS[s].y, o, d);
+        acc += sdf_trace(o, d, SDF_SAMPLE_WEIGHT);
+    }
+    acc = vec3(acc.x >= 0.0 ? min(acc.x, 1e30) : 0.0, acc.y >= 0.0 ? min(acc.y, 1e30) : 0.0, acc.z >= 0.0 ? min(acc.z, 1e30) : 0.0);
+    return vec4(sdf_to_srgb(acc.x), sdf_to_srgb(acc.y), sdf_to_srgb(acc.z), 1.0);
+}
+)";
+
+}  // namespace sdfc::glsl

@@ -1,0 +1,79 @@
+// Errors a script can cause: exact texts, locations and carets (LANGUAGE.md section 9).
+#include <catch2/catch.hpp>
+
+#include "support.hpp"
+
+using namespace sdfc;
+using test::error_of;
+using test::first_error_line;
+
+TEST_CASE("a diagnostic quotes the line with a caret under the column") {
+    CHECK(error_of("sphere(-1);") ==
+          "test.sdf:1:8: error: argument 'r' of sphere must be zero or positive, not -1\n"
+          "sphere(-1);\n"
+          "       ^\n");
+}
+
+TEST_CASE("unknown names suggest the nearest known one") {
+    CHECK(first_error_line("spher(1);") == "test.sdf:1:1: error: unknown name 'spher' (did you mean `sphere`?)");
+    CHECK(first_error_line("let radius = 1;\nsphere(radiu);") ==
+          "test.sdf:2:8: error: unknown name 'radiu' (did you mean `radius`?)");
+    CHECK(first_error_line("zzzzqqq(1);") == "test.sdf:1:1: error: unknown name 'zzzzqqq'");
+}
+
+TEST_CASE("wrong argument count, unknown names and types name the parameter") {
+    CHECK(first_error_line("sphere(1, 2);") ==
+          "test.sdf:1:11: error: sphere takes at most 1 argument (r), but more were given");
+    CHECK(first_error_line("torus(majr = 1, minor = 0.2);") ==
+          "test.sdf:1:7: error: torus has no parameter 'majr' (did you mean `major`?)");
+    CHECK(first_error_line("box([1, 2]);") ==
+          "test.sdf:1:5: error: argument 'size' of box must be a number or a 3-component vector, not a 2-component vector");
+    CHECK(first_error_line("sphere();") == "test.sdf:1:1: error: missing argument 'r' of sphere");
+    CHECK(first_error_line("torus(1, major = 2);") == "test.sdf:1:10: error: argument 'major' of torus is given twice");
+    CHECK(first_error_line("def f(a) = sphere(a);\nf(1, 2);") == "test.sdf:2:6: error: f takes 1 argument, but more were given");
+    CHECK(first_error_line("def f(a) = sphere(a);\nf(b = 2);") == "test.sdf:2:3: error: f has no parameter 'b'");
+    CHECK(first_error_line("translate(1) sphere(1);") ==
+          "test.sdf:1:11: error: argument 'v' of translate must be a 3-component vector, not a number");
+}
+
+TEST_CASE("type errors and vector sizes") {
+    CHECK(first_error_line("sphere([1, 2] + [1, 2, 3]);") == "test.sdf:1:15: error: vector sizes differ: 2 and 3 components");
+    CHECK(first_error_line("sphere(1 + \"a\");") == "test.sdf:1:10: error: cannot apply '+' to a number and a string");
+    CHECK(first_error_line("1 + 2;") ==
+          "test.sdf:1:3: error: this statement computes a number but does nothing with it (a statement must be a shape or a setting)");
+    CHECK(first_error_line("translate([1, 0, 0]);") ==
+          "test.sdf:1:1: error: 'translate' needs a shape to apply to, e.g. translate(...) sphere(1);");
+}
+
+TEST_CASE("settings may appear once") {
+    CHECK(first_error_line("camera();\ncamera();") == "test.sdf:2:1: error: a second camera statement (the first is at line 1)");
+    CHECK(first_error_line("render();\nrender(width = 10);") == "test.sdf:2:1: error: a second render statement (the first is at line 1)");
+}
+
+TEST_CASE("NaN, infinity and negative sizes") {
+    CHECK(first_error_line("sphere(1 / 0);") == "test.sdf:1:10: error: division by zero");
+    CHECK(first_error_line("box([1, -2, 1]);") ==
+          "test.sdf:1:5: error: argument 'size' of box must be zero or positive, not -2");
+    CHECK(first_error_line("sphere(sqrt(-1));") == "test.sdf:1:13: error: sqrt of a negative number");
+    CHECK(first_error_line("sphere(pow(10, 100));") == "test.sdf:1:8: error: this expression is not a finite number (inf)");
+}
+
+TEST_CASE("recursion and loop limits give errors, not hangs") {
+    CHECK(first_error_line("def f(n) = f(n + 1);\nsphere(f(0));") ==
+          "test.sdf:1:12: error: recursion deeper than 64 calls in 'f' (raise it with --max-recursion)");
+    CHECK(first_error_line("for (i = [0 : 200000]) sphere(1);") ==
+          "test.sdf:1:10: error: this range has 200001 elements, over the loop limit of 100000 (raise it with --max-iterations)");
+}
+
+TEST_CASE("several independent errors are all reported") {
+    std::string e = error_of("sphere(-1);\nbox(1);\ntorus(1);\n");
+    CHECK(e.find("test.sdf:1:8: error:") != std::string::npos);
+    CHECK(e.find("test.sdf:3:1: error: missing argument 'minor' of torus") != std::string::npos);
+}
+
+TEST_CASE("var is for field blocks; let cannot be reassigned") {
+    CHECK(first_error_line("var x = 1;") == "test.sdf:1:1: error: 'var' is only allowed inside a field block; use 'let' for a constant");
+    CHECK(first_error_line("field (p) -> { let d = 1; d = 2; d };") ==
+          "test.sdf:1:27: error: 'd' is a constant (declared with let at line 1); declare it with var to reassign it");
+    CHECK(first_error_line("let a = 1;\nlet a = 2;") == "test.sdf:2:5: error: 'a' is already defined in this scope (at line 1)");
+}

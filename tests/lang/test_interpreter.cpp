@@ -1,0 +1,180 @@
+// The interpreter: lets, defs, loops, conditionals, vectors and shapes, checked through the
+// distances of the scenes they build.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "support.hpp"
+
+using namespace sdfc;
+using test::dist_of;
+
+namespace {
+bool close(double got, double want) { return std::fabs(got - want) <= 1e-5 * (1 + std::fabs(want)); }
+}  // namespace
+
+TEST_CASE("let binds constants") {
+    CHECK(close(dist_of("let r = 0.5; sphere(r);", 1, 0, 0), 0.5));
+    CHECK(close(dist_of("let a = 2; let b = a * 3 + 1; sphere(b);", 0, 0, 0), -7));
+}
+
+TEST_CASE("def returns shapes and values, with defaults and named arguments") {
+    const char* ring = "def ring(R, t = 0.1) = rotate(x = 90) torus(R, t);\n";
+    CHECK(close(dist_of(std::string(ring) + "ring(2);", 2, 0, 0), -0.1));
+    CHECK(close(dist_of(std::string(ring) + "ring(2);", 0, 2, 0), -0.1));  // now in the xy-plane
+    CHECK(close(dist_of(std::string(ring) + "ring(t = 0.5, R = 1);", 1, 0, 0), -0.5));
+    CHECK(close(dist_of("def lerp3(a, b, k) = a + (b - a) * k; sphere(lerp3(1, 3, 0.5));", 0, 0, 0), -2));
+    CHECK(close(dist_of("def pair() = { sphere(1); translate([3, 0, 0]) box(1); }; pair();", 3, 0, 0), -0.5));
+}
+
+TEST_CASE("defs may be used before the line that defines them") {
+    CHECK(close(dist_of("thing();\ndef thing() = sphere(2);", 0, 0, 0), -2));
+}
+
+TEST_CASE("for unions its iterations; nested bindings; vectors") {
+    const char* ring = "for (i = [0 : 7]) rotate(y = 45 * i) translate([2, 0, 0]) sphere(0.2);";
+    CHECK(close(dist_of(ring, 2, 0, 0), -0.2));
+    CHECK(close(dist_of(ring, 0, 0, 2), -0.2));
+    CHECK(close(dist_of(ring, std::sqrt(2.0), 0, std::sqrt(2.0)), -0.2));
+    const char* grid = "for (x = [0 : 2], z = [0 : 2]) translate([x, 0, z]) box(0.4);";
+    CHECK(close(dist_of(grid, 2, 0, 2), -0.2));
+    CHECK(close(dist_of(grid, 1, 0, 0), -0.2));
+    CHECK(close(dist_of(grid, 3, 0, 0), 0.8));
+    CHECK(close(dist_of("for (s = [-1, 1]) translate([s * 2, 0, 0]) sphere(0.5);", -2, 0, 0), -0.5));
+    CHECK(close(dist_of("for (i = [0 : 0.5 : 1]) translate([i * 4, 0, 0]) sphere(0.1);", 2, 0, 0), -0.1));
+    CHECK(close(dist_of("for (p = [[1, 0, 0], [0, 5, 0]]) translate(p) sphere(0.5);", 0, 5, 0), -0.5));
+}
+
+TEST_CASE("if/else at statement level and ?: in expressions") {
+    CHECK(close(dist_of("let r = 0.5; if (r > 0.3) sphere(r); else box(r);", 0, 0, 1), 0.5));
+    CHECK(close(dist_of("let r = 0.2; if (r > 0.3) sphere(r); else box(r);", 0, 0, 1), 0.9));
+    CHECK(close(dist_of("let k = 1; k > 0 ? sphere(1) : { box(1); };", 2, 0, 0), 1));
+    CHECK(close(dist_of("let k = -1; k > 0 ? sphere(1) : { box(1); translate([5, 0, 0]) box(1); };", 5, 0, 0), -0.5));
+    CHECK(close(dist_of("sphere(true && !false ? 1 : 2);", 0, 0, 0), -1));
+}
+
+TEST_CASE("vectors broadcast like GLSL; swizzles and indexing") {
+    CHECK(close(dist_of("translate([1, 2, 3] * 2 - 1) sphere(1);", 1, 3, 5), -1));
+    CHECK(close(dist_of("let v = [1, 2, 3]; translate(v.zyx) sphere(0.5);", 3, 2, 1), -0.5));
+    CHECK(close(dist_of("let v = [1, 2, 3]; sphere(v[2] + v.x);", 0, 0, 0), -4));
+    CHECK(close(dist_of("let c = [0.1, 0.2, 0.3]; sphere(c.b * 10 + c.r);", 0, 0, 0), -3.1));
+    CHECK(close(dist_of("sphere(length([3, 4]) + dot([1, 2, 3], [1, 1, 1]));", 0, 0, 0), -11));
+    CHECK(close(dist_of("translate(cross([1, 0, 0], [0, 1, 0]) * 4) sphere(1);", 0, 0, 4), -1));
+    CHECK(close(dist_of("sphere(mod(-1, 3) + 7 % 4);", 0, 0, 0), -5));
+}
+
+TEST_CASE("built-in math and constants") {
+    CHECK(close(dist_of("sphere(sin(pi / 2) + cos(0) + sqrt(4) + pow(2, 3) + abs(-1));", 0, 0, 0), -13));
+    CHECK(close(dist_of("sphere(clamp(5, 0, 2) + mix(0, 10, 0.25) + step(0.5, 0.7) + smoothstep(0, 1, 0.5));", 0, 0, 0), -6));
+    CHECK(close(dist_of("sphere(degrees(radians(90)) / 90 + floor(1.7) + ceil(1.2) + fract(2.25) + sign(-3) + 2);", 0, 0, 0), -5.25));
+    CHECK(close(dist_of("sphere(atan2(1, 1) * 4 / pi + atan(1, 1) * 4 / pi + tau / pi + e - e);", 0, 0, 0), -4));
+    CHECK(close(dist_of("sphere(min(3, 1, 2) + max([1, 5, 2]) + length(normalize([3, 0, 4])));", 0, 0, 0), -7));
+    CHECK(close(dist_of("sphere(exp(log(2)) + distance([0, 0, 0], [0, 3, 4]));", 0, 0, 0), -7));
+}
+
+TEST_CASE("a statement that is an expression of type shape adds it") {
+    CHECK(close(dist_of("let c = cylinder(2, 1); c;", 0, 0, 0), -1));
+    CHECK(close(dist_of("{ sphere(1); translate([4, 0, 0]) sphere(1); }", 4, 0, 0), -1));
+}
+
+TEST_CASE("recursion unrolls at compile time") {
+    const char* tower =
+        "def tower(n) = n == 0 ? sphere(0.5) : union { sphere(0.5); translate([0, 1, 0]) tower(n - 1); };\n"
+        "tower(3);";
+    CHECK(close(dist_of(tower, 0, 3, 0), -0.5));
+    CHECK(close(dist_of(tower, 0, 4, 0), 0.5));
+}
+
+TEST_CASE("custom fields: var, reassignment, loops, shapes applied to points") {
+    CHECK(close(dist_of("field (p) -> length(p) - 1;", 2, 0, 0), 1));
+    CHECK(close(dist_of("field(bound = 2) (p) -> 2 * (length(p) - 1);", 3, 0, 0), 2));
+    CHECK(close(dist_of("field (p) -> box(2)(p);", 3, 0, 0), 2));
+    const char* hollow =
+        "def hollow(s, w) = field (p) -> max(s(p), -(s(p) + w));\n"
+        "hollow(sphere(1), 0.2);";
+    CHECK(close(dist_of(hollow, 0, 0, 0), 0.8));
+    CHECK(close(dist_of(hollow, 0.9, 0, 0), -0.1));
+    const char* counter =
+        "field (p) -> { var d = 10; var s = 1; for (i = [1 : 3]) { s = s * 2; d = min(d, length(p) - s); } d };";
+    CHECK(close(dist_of(counter, 0, 0, 0), -8));
+}
+
+TEST_CASE("the menger sponge of LANGUAGE.md section 7") {
+    const char* menger = R"(
+def menger(n) = field (p) -> {
+    var d = box(2)(p);
+    var s = 1;
+    for (m = [1 : n]) {
+        let a = mod(p * s, 2) - 1;
+        s = s * 3;
+        let r = abs(1 - 3 * abs(a));
+        let c = (min(max(r.x, r.y), min(max(r.y, r.z), max(r.z, r.x))) - 1) / s;
+        d = max(d, c);
+    }
+    d
+};
+menger(4);
+)";
+    auto c = test::compile_text(menger);
+    // The centre hole goes through along every axis; the corner cube is solid.
+    CHECK(test::dist(c->cs, 0, 0, 0) > 0);
+    CHECK(test::dist(c->cs, 0.9, 0.9, 0.9) < 0);
+    CHECK(close(test::dist(c->cs, 3, 0.9, 0.9), 2));
+}
+
+TEST_CASE("time is 0 by default and folds to the frame's value") {
+    CHECK(close(dist_of("sphere(1 + time);", 0, 0, 0), -1));
+    InterpretOptions o;
+    o.time = 2.0f;
+    auto c = test::compile_text("translate([time, 0, 0]) sphere(1);", "t.sdf", o);
+    CHECK(close(test::dist(c->cs, 2, 0, 0), -1));
+}
+
+TEST_CASE("scene settings are read") {
+    auto c = test::compile_text(
+        "camera(position = [0, 3, 9], target = [0, 1, 0], fov = 40);\n"
+        "light(position = [5, 8, 4], color = [1, 0.9, 0.8], intensity = 60);\n"
+        "light(direction = [0, -1, 0]);\n"
+        "ambient([0.1, 0.2, 0.3]); background(0.5);\n"
+        "render(width = 320, height = 200, samples = 2, max_steps = 99, max_distance = 50, epsilon = 1e-3, shadows = false, ao = false, max_bounces = 1);\n"
+        "sphere(1);");
+    const CompiledScene& s = c->cs;
+    CHECK(s.camera.position == glm::vec3(0, 3, 9));
+    CHECK(s.camera.target == glm::vec3(0, 1, 0));
+    CHECK(s.camera.fov == 40);
+    REQUIRE(s.lights.size() == 2);
+    CHECK(s.lights[0].intensity == 60);
+    CHECK(!s.lights[0].directional);
+    CHECK(s.lights[1].directional);
+    CHECK(s.lights[1].direction == glm::vec3(0, -1, 0));
+    CHECK(s.ambient == glm::vec3(0.1f, 0.2f, 0.3f));
+    CHECK(s.background == glm::vec3(0.5f));
+    CHECK(s.render.width == 320);
+    CHECK(s.render.height == 200);
+    CHECK(s.render.samples == 2);
+    CHECK(s.render.max_steps == 99);
+    CHECK(s.render.max_distance == 50);
+    CHECK(s.render.epsilon == Approx(1e-3));
+    CHECK(!s.render.shadows);
+    CHECK(!s.render.ao);
+    CHECK(s.render.max_bounces == 1);
+}
+
+TEST_CASE("materials are values and modifiers; the inner one wins") {
+    auto c = test::compile_text(
+        "let gold = material(color = [0.9, 0.7, 0.2], specular = 0.6, shininess = 64);\n"
+        "material(color = [1, 0, 0]) { material(gold) sphere(1); translate([3, 0, 0]) sphere(1); }\n"
+        "translate([-3, 0, 0]) color([0, 0, 1]) sphere(1);");
+    auto mat_at = [&](float x) { return eval_scalar(c->cs.shading, x, 0, 0); };
+    auto g = mat_at(0);
+    CHECK(g[1] == Approx(0.9));
+    CHECK(g[2] == Approx(0.7));
+    CHECK(g[3] == Approx(0.2));
+    CHECK(g[5] == Approx(64));
+    auto r = mat_at(3);
+    CHECK(r[1] == Approx(1));
+    CHECK(r[2] == Approx(0));
+    auto b = mat_at(-3);
+    CHECK(b[3] == Approx(1));
+    CHECK(b[1] == Approx(0));
+}
