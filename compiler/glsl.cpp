@@ -62,6 +62,7 @@ struct Parts {
 Parts generate(const Scene& scene) {
     Graph& g = *scene.graph;
     const Loc saved = g.loc();
+    g.set_loc(Loc{});  // nodes made outside any shape (the scene's final scaling) name no line
     LoweredScene ls = lower_scene(g, scene);
     Program dist = codegen(g, {ls.distance}, {"d"});
     std::vector<NodeId> mroots(ls.material.begin(), ls.material.end());
@@ -150,6 +151,7 @@ Parts generate(const Scene& scene) {
     }
 
     glsl::FunctionSpec fs;
+    if (scene.root->kind == ShapeKind::Union) fs.quiet = scene.root->loc;
     fs.signature = "float map(vec3 p)";
     fs.var_prefix = "d";
     c += "\n// ---- the scene's distance (a safe bound: 1-Lipschitz) ----\n";
@@ -187,6 +189,15 @@ Parts generate(const Scene& scene) {
         l.push_back("sdf_cam_ortho_height = " + o[10] + ";");
         l.push_back("sdf_ambient = " + v3(11) + ";");
         l.push_back("sdf_background = " + v3(14) + ";");
+        if (lights.empty()) {
+            // The default rig of compiler/compile.cpp: a key light over the camera's shoulder
+            // and a dim fill from the other side, both directional.
+            l.push_back("vec3 fwd = normalize(sdf_cam_target - sdf_cam_position);");
+            l.push_back("vec3 right = normalize(cross(fwd, sdf_cam_up));");
+            l.push_back("vec3 up = normalize(sdf_cam_up);");
+            l.push_back("sdf_lights[0] = SdfLight(true, vec3(0.0), normalize(fwd + 0.6 * right - 1.2 * up), vec3(1.0, 0.97, 0.92), 1.0, 0.0);");
+            l.push_back("sdf_lights[1] = SdfLight(true, vec3(0.0), normalize(fwd - 0.8 * right - 0.3 * up), vec3(0.55, 0.6, 0.7), 0.35, 0.0);");
+        }
         for (size_t i = 0; i < lights.size(); ++i) {
             const size_t b = 17 + 8 * i;
             const std::string ln = lights[i].loc.known() ? fmt::format("  // line {}", lights[i].loc.line) : "";

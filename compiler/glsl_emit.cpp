@@ -150,7 +150,9 @@ std::string function(const Program& prog, const FunctionSpec& spec) {
             uses[i] == 0) {
             expr[i] = std::move(text);
         } else {
-            if (i < prog.locs.size() && prog.locs[i].known() &&
+            const bool quiet = i < prog.locs.size() && prog.locs[i].file == spec.quiet.file && prog.locs[i].line == spec.quiet.line &&
+                               prog.locs[i].col == spec.quiet.col;
+            if (i < prog.locs.size() && prog.locs[i].known() && !quiet &&
                 (prog.locs[i].file != last_file || prog.locs[i].line != last_line)) {
                 const Loc& l = prog.locs[i];
                 last_file = l.file, last_line = l.line;

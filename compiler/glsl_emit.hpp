@@ -29,6 +29,7 @@ struct FunctionSpec {
     std::function<std::vector<std::string>(const std::vector<std::string>& outs)> finish;
     std::string indent = "    ";
     size_t inline_limit = 72;  // single-use expressions up to this length are inlined
+    Loc quiet;                 // instructions at this location get no comment (the scene's implicit union)
 };
 
 // The program as a GLSL function. Instructions are walked in order and renamed to SSA

@@ -347,7 +347,7 @@ vec3 sdf_local_light(vec3 P, vec3 D, vec3 N, float path, Material m, vec3 lw) {
 }
 
 // Settings the CPU compiler resolves (compiler/compile.cpp): light directions normalised,
-// the default two-light rig when the script has no light.
+// colours of ambient and background made finite and non-negative.
 void sdf_init_scene() {
     if (!SDF_DEFAULT_LIGHTS) {
         for (int i = 0; i < SDF_NUM_LIGHTS; ++i)
@@ -355,12 +355,6 @@ void sdf_init_scene() {
                 vec3 d = sdf_lights[i].direction;
                 sdf_lights[i].direction = length(d) > 0.0 ? normalize(d) : vec3(0.0, -1.0, 0.0);
             }
-    } else {
-        vec3 fwd = normalize(sdf_cam_target - sdf_cam_position);
-        vec3 right = normalize(cross(fwd, sdf_cam_up));
-        vec3 up = normalize(sdf_cam_up);
-        sdf_lights[0] = SdfLight(true, vec3(0.0), normalize(fwd + 0.6 * right - 1.2 * up), vec3(1.0, 0.97, 0.92), 1.0, 0.0);
-        sdf_lights[1] = SdfLight(true, vec3(0.0), normalize(fwd - 0.8 * right - 0.3 * up), vec3(0.55, 0.6, 0.7), 0.35, 0.0);
     }
     sdf_ambient = vec3(sdf_nonneg(sdf_ambient.x), sdf_nonneg(sdf_ambient.y), sdf_nonneg(sdf_ambient.z));
     sdf_background = vec3(sdf_nonneg(sdf_background.x), sdf_nonneg(sdf_background.y), sdf_nonneg(sdf_background.z));

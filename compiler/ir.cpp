@@ -9,13 +9,40 @@ namespace sdfc {
 
 Graph::Graph() {
     nodes_.reserve(1024);
+    table_.assign(2048, kNoNode);
+}
+
+uint64_t Graph::hash(const Node& n) {
+    auto mix = [](uint64_t h) {  // murmur3's finaliser
+        h ^= h >> 33; h *= 0xff51afd7ed558ccdull; h ^= h >> 33; h *= 0xc4ceb9fe1a85ec53ull; h ^= h >> 33;
+        return h;
+    };
+    uint64_t ab = uint64_t(n.a) | (uint64_t(n.b) << 32);
+    uint64_t ck = uint64_t(n.c) | (uint64_t(std::bit_cast<uint32_t>(n.k)) << 32);
+    return mix(mix(ab ^ uint64_t(n.op)) + ck);
+}
+
+void Graph::grow_table() {
+    std::vector<NodeId> t(table_.size() * 2, kNoNode);
+    const size_t mask = t.size() - 1;
+    for (NodeId id = 0; id < nodes_.size(); ++id) {
+        size_t i = hash(nodes_[id]) & mask;
+        while (t[i] != kNoNode) i = (i + 1) & mask;
+        t[i] = id;
+    }
+    table_.swap(t);
 }
 
 NodeId Graph::intern(const Node& n) {
-    Key key{uint64_t(n.a) | (uint64_t(n.b) << 32), uint64_t(n.c) | (uint64_t(std::bit_cast<uint32_t>(n.k)) << 32),
-            static_cast<uint32_t>(n.op)};
-    auto it = table_.find(key);
-    if (it != table_.end()) return it->second;
+    const size_t mask = table_.size() - 1;
+    const uint32_t kbits = std::bit_cast<uint32_t>(n.k);
+    size_t i = hash(n) & mask;
+    for (;; i = (i + 1) & mask) {
+        NodeId id = table_[i];
+        if (id == kNoNode) break;
+        const Node& m = nodes_[id];
+        if (m.op == n.op && m.a == n.a && m.b == n.b && m.c == n.c && std::bit_cast<uint32_t>(m.k) == kbits) return id;
+    }
     if (nodes_.size() >= node_limit_)
         throw CompileError(cur_loc_, fmt::format("the program grew past {} operations (raise it with --max-ops)", node_limit_));
     NodeId id = static_cast<NodeId>(nodes_.size());
@@ -27,7 +54,8 @@ NodeId Graph::intern(const Node& n) {
         if (arg != kNoNode) f |= flags_[arg];
     flags_.push_back(f);
     locs_.push_back(cur_loc_);
-    table_.emplace(key, id);
+    table_[i] = id;
+    if (nodes_.size() * 2 > table_.size()) grow_table();  // load factor <= 1/2
     return id;
 }
 

@@ -7,7 +7,6 @@
 #pragma once
 #include <cstdint>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "compiler/opcodes.hpp"
@@ -72,22 +71,14 @@ public:
 private:
     enum : uint8_t { kTime = 1, kPoint = 2 };
     NodeId intern(const Node& n);
-    struct Key {
-        uint64_t ab, ck;
-        uint32_t op;
-        bool operator==(const Key&) const = default;
-    };
-    struct KeyHash {
-        size_t operator()(const Key& k) const {
-            uint64_t h = k.ab * 0x9E3779B97F4A7C15ull;
-            h ^= (k.ck + 0x632BE59BD9B4E019ull + (h << 6) + (h >> 2)) * 0xBF58476D1CE4E5B9ull;
-            return static_cast<size_t>(h ^ (h >> 31) ^ k.op);
-        }
-    };
+    static uint64_t hash(const Node& n);
+    void grow_table();
     std::vector<Node> nodes_;
     std::vector<uint8_t> flags_;
     std::vector<Loc> locs_;
-    std::unordered_map<Key, NodeId, KeyHash> table_;
+    // Open-addressing hash set of node ids (power-of-two size, linear probing, kNoNode =
+    // empty); the key is the node itself, so nothing but the id is stored.
+    std::vector<NodeId> table_;
     Loc cur_loc_;
     size_t node_limit_ = 20'000'000;
 };

@@ -388,17 +388,12 @@ Lowered lower_primitive(L& l, const Shape& s, const Vec3N& p) {
             break;
         }
         case ShapeKind::Ellipsoid: {
-            // Quilez's improved ellipsoid bound k0 (k0 - 1) / k1. Not exact; its gradient
-            // can exceed 1 slightly for elongated ellipsoids, so it is scaled by the radius ratio.
+            // (length(p / r) - 1) * min(r): 1-Lipschitz, exact along the shortest axis, a bound
+            // elsewhere. (Quilez's k0 (k0 - 1) / k1 is tighter near the surface but its gradient
+            // reaches several times 1 near the centre of elongated ellipsoids.)
             Vec3N r = P3(s, 0);
             NodeId k0 = l.len3(l.div(x, r[0]), l.div(y, r[1]), l.div(z, r[2]));
-            NodeId k1 = l.len3(l.div(x, l.sq(r[0])), l.div(y, l.sq(r[1])), l.div(z, l.sq(r[2])));
-            d = l.div(l.mul(k0, l.sub(k0, l.c(1))), l.mx(k1, l.c(1e-12f)));
-            if (g.is_const(r[0]) && g.is_const(r[1]) && g.is_const(r[2])) {
-                float lo = std::min({g.const_value(r[0]), g.const_value(r[1]), g.const_value(r[2])});
-                float hi = std::max({g.const_value(r[0]), g.const_value(r[1]), g.const_value(r[2])});
-                lip = lo > 0 ? std::max(1.0f, std::sqrt(hi / lo)) : 1.0f;
-            }
+            d = l.mul(l.sub(k0, l.c(1)), l.mn(r[0], l.mn(r[1], r[2])));
             break;
         }
         case ShapeKind::Octahedron: {
@@ -432,9 +427,10 @@ Lowered lower_primitive(L& l, const Shape& s, const Vec3N& p) {
             NodeId cnd = l.lt(zero, l.mn(qy, l.sub(l.mul(l.neg(qx), m2), l.mul(qy, half))));
             NodeId d2 = l.sel(cnd, zero, l.mn(a, b));
             d = l.mul(l.sqrt(l.div(l.add(d2, l.sq(qz)), m2)), g.unary(Op::Sign, l.mx(qz, l.neg(y))));
-            // Below the base his formula overestimates; there the nearest point is on the base square.
+            // His formula measures only to the slanted faces: below the base the nearest point
+            // is on the base square, and inside the base face may be nearer than the sides.
             NodeId base = l.len3(l.mx(l.sub(ax, half), zero), y, l.mx(l.sub(az, half), zero));
-            d = l.sel(l.lt(y, zero), base, d);
+            d = l.sel(l.lt(y, zero), base, l.mx(d, l.neg(y)));
             break;
         }
         case ShapeKind::HexPrism: {
@@ -539,17 +535,20 @@ Lowered lower_csg(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherit
                 if (s.kind != ShapeKind::SmoothUnion) d = l.neg(d);
                 break;
             }
+            // hg_sdf's chamfers scale the diagonal term by sqrt(1/2); its gradient then reaches
+            // sqrt(2) where the operands' gradients align. Halving it instead keeps the same
+            // surface (same sign everywhere) and a 1-Lipschitz field.
             case ShapeKind::ChamferUnion:
-                d = l.mn(l.mn(a, b), l.mul(l.sub(l.add(a, b), P(s, 0)), l.c(0.70710678f)));
+                d = l.mn(l.mn(a, b), l.mul(l.sub(l.add(a, b), P(s, 0)), l.c(0.5f)));
                 closer_a = l.lt(a, b);
                 break;
             case ShapeKind::ChamferIntersection:
-                d = l.mx(l.mx(a, b), l.mul(l.add(l.add(a, b), P(s, 0)), l.c(0.70710678f)));
+                d = l.mx(l.mx(a, b), l.mul(l.add(l.add(a, b), P(s, 0)), l.c(0.5f)));
                 closer_a = l.lt(b, a);
                 break;
             case ShapeKind::ChamferDifference: {
                 NodeId nb = l.neg(b);
-                d = l.mx(l.mx(a, nb), l.mul(l.add(l.add(a, nb), P(s, 0)), l.c(0.70710678f)));
+                d = l.mx(l.mx(a, nb), l.mul(l.add(l.add(a, nb), P(s, 0)), l.c(0.5f)));
                 closer_a = l.lt(nb, a);
                 break;
             }

@@ -714,7 +714,7 @@ size_t previous_token_end(std::string_view t, size_t off) {
 }
 
 bool token_start(unsigned char c) {
-    return std::isalnum(c) || c == '_' || std::strchr(".\"()[]{},;:?=!<>+-*/%&|", c) != nullptr;
+    return std::isalnum(c) || c == '_' || (c != 0 && std::strchr(".\"()[]{},;:?=!<>+-*/%&|", c) != nullptr);
 }
 
 const char* const lexical_messages[] = {

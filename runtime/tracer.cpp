@@ -22,7 +22,8 @@
 //    vis = 0.25 (1 + res)^2 (2 - res) for res in [-1, 1]. w = radius / distance for point
 //    lights, w = radius (tangent of the angular radius) for directional ones.
 //  * Ambient occlusion: 5 taps along the normal at h = 0.01 .. 0.13 (world units),
-//    ao = clamp(1 - 3 * sum (h - d(p + n h)) * 0.95^i, 0, 1); it scales the ambient term.
+//    ao = clamp(1 - 3 * sum max(h - d(p + n h), 0) * 0.95^i, 0, 1) (Quilez); it scales the
+//    ambient term only.
 //  * Reflection/refraction, iterative (a wavefront of ray generations, not recursion), at
 //    most max_bounces generations after the primary one. At a surface with weight W:
 //    local shading gets W (1 - reflect)(1 - transparency), the mirror ray W * reflect, and
@@ -38,6 +39,11 @@
 //  * AOVs: depth = first-hit distance (max_distance for misses; per pixel the minimum over
 //    samples), normal = unit world normal of the first hit (sample average, renormalised),
 //    steps = average primary-ray step count.
+//  * Over-relaxed sphere tracing (Keinert et al. 2014, omega = 1.5 falling back to 1 when
+//    consecutive unbounding spheres stop overlapping) for camera, secondary and hard shadow
+//    rays: fewer steps, same hits for any 1-Lipschitz bound.
+//  * Raw fields (CompiledScene::raw_field, .vm models, no distance bound): see march_raw();
+//    sign-change marching with bisection, hard shadows only, no AO, no cone tracing.
 //  * 2D models (CompiledScene::is_2d): W x H samples over [-1, 1]^2 including both ends,
 //    row 0 at y = +1, white where the field is < 0, black elsewhere.
 // FP exceptions are never unmasked here, so GCC may if-convert float compares: the lane

@@ -38,24 +38,46 @@ Evaluator::Evaluator(const Program& program)
       storage_(alloc_regs(static_cast<size_t>(program.num_regs) * kBatch), &free_aligned),
       regs_(storage_.get()) {}
 
-void Evaluator::eval(const float* x, const float* y, const float* z, int n, float time) {
-    const int m = (n + kGroup - 1) / kGroup * kGroup;  // lanes computed
-    float* const base = regs_;
+// One pass over the program with the lane count M known at compile time when FULL (the
+// loops unroll completely) or given at run time (m, a multiple of kGroup) otherwise.
+// Dispatch is a computed goto with one indirect jump per handler (GCC/clang), which the
+// branch predictor learns per opcode, or a switch elsewhere.
+template <bool FULL>
+static inline void run(const Instr* code, const Instr* end, float* base, const float* x, const float* y,
+                       const float* z, int n, int m_rt, float time) {
+    const int m = FULL ? kBatch : m_rt;
     auto load = [&](float* R, const float* src) {
         std::memcpy(R, src, sizeof(float) * static_cast<size_t>(n));
         for (int i = n; i < m; ++i) R[i] = src[n - 1];  // keep padding lanes finite
     };
-    for (const Instr& in : program_->code) {
-        float* R = base + static_cast<size_t>(in.out) * kBatch;
-        const float* A = base + static_cast<size_t>(in.a) * kBatch;
-        const float* B = base + static_cast<size_t>(in.b) * kBatch;
-        const float* C = base + static_cast<size_t>(in.c) * kBatch;
-        const float k = in.k;
-        switch (in.op) {
-            // Every row of the opcode table: inputs are copied in, the rest is one lane
-            // loop over the row's semantics, which the compiler vectorises.
+    const Instr* ip = code;
+    if (ip == end) return;
+#if defined(__GNUC__)
+    static const void* const labels[] = {
+#define OP(name, mn, ar, imm, sem, glsl) &&L_##name,
+#include "compiler/opcodes.def"
+#undef OP
+    };
+#define SDFC_NEXT                     \
+    do {                              \
+        if (++ip == end) return;      \
+        goto* labels[int(ip->op)];    \
+    } while (0)
+    goto* labels[int(ip->op)];
+#define SDFC_CASE(name) L_##name:
+#else
+#define SDFC_NEXT break
+#define SDFC_CASE(name) case Op::name:
+    for (; ip != end; ++ip)
+        switch (ip->op) {
+#endif
 #define OP(name, mn, ar, imm, sem, glsl)                                           \
-    case Op::name:                                                                 \
+    SDFC_CASE(name) {                                                              \
+        float* R = base + static_cast<size_t>(ip->out) * kBatch;                   \
+        [[maybe_unused]] const float* A = base + static_cast<size_t>(ip->a) * kBatch; \
+        [[maybe_unused]] const float* B = base + static_cast<size_t>(ip->b) * kBatch; \
+        [[maybe_unused]] const float* C = base + static_cast<size_t>(ip->c) * kBatch; \
+        [[maybe_unused]] const float k = ip->k;                                    \
         if constexpr (Op::name == Op::VarX) load(R, x);                            \
         else if constexpr (Op::name == Op::VarY) load(R, y);                       \
         else if constexpr (Op::name == Op::VarZ) load(R, z);                       \
@@ -69,11 +91,23 @@ void Evaluator::eval(const float* x, const float* y, const float* z, int n, floa
                 R[i] = (sem);                                                      \
             }                                                                      \
         }                                                                          \
-        break;
+    }                                                                              \
+    SDFC_NEXT;
 #include "compiler/opcodes.def"
 #undef OP
+#if !defined(__GNUC__)
         }
-    }
+#endif
+#undef SDFC_NEXT
+#undef SDFC_CASE
+}
+
+void Evaluator::eval(const float* x, const float* y, const float* z, int n, float time) {
+    const int m = (n + kGroup - 1) / kGroup * kGroup;  // lanes computed
+    const Instr* code = program_->code.data();
+    const Instr* end = code + program_->code.size();
+    if (m == kBatch) run<true>(code, end, regs_, x, y, z, n, m, time);
+    else run<false>(code, end, regs_, x, y, z, n, m, time);
 }
 
 float Evaluator::eval1(float x, float y, float z, float time) {

@@ -71,13 +71,13 @@ TEST_CASE("smooth operations equal the hard ones beyond k and blend within") {
     });
 }
 
-TEST_CASE("chamfer and stairs operations follow hg_sdf") {
+TEST_CASE("chamfer and stairs operations follow hg_sdf (chamfer's diagonal halved: same surface, 1-Lipschitz)") {
     Field cu("chamfer_union(0.4) { translate([-5, 0, 0]) box([10, 10, 10]); translate([0, -5, 0]) box([10, 10, 10]); }");
     // Two boxes meeting at a right angle (x < 0 and y < 0 solids): the chamfer cuts the corner.
-    CHECK(close(cu(0.3, 0.3, 0), std::min(0.3, (0.3 + 0.3 - 0.4) * std::sqrt(0.5))));
-    CHECK(close(cu(3, 3, 0), 3));
+    CHECK(close(cu(0.3, 0.3, 0), std::min(0.3, (0.3 + 0.3 - 0.4) * 0.5)));
+    CHECK(close(cu(3, 3, 0), (3 + 3 - 0.4) * 0.5));  // a bound there: below the true 3
     Field ci("chamfer_intersection(0.4) { box(2); translate([0.5, 0, 0]) box(2); }");
-    CHECK(close(ci(0, 0, 0), std::max({-1.0, -0.5, (-1 - 0.5 + 0.4) * std::sqrt(0.5)})));
+    CHECK(close(ci(0, 0, 0), std::max({-1.0, -0.5, (-1 - 0.5 + 0.4) * 0.5})));
     Field cd("chamfer_difference(0.4) { box(2); translate([2, 0, 0]) box(2); }");
     CHECK(cd(0.95f, 0.95f, 0) > -0.05f);
     auto stairs = [](double a, double b, double r, double n) {

@@ -159,12 +159,11 @@ TEST_CASE("plane: the half-space below") {
     CHECK(close(dist_of("plane([1, 1, 0], 0);", 1, 1, 0), std::sqrt(2.0)));
 }
 
-TEST_CASE("ellipsoid: exact on the axes, a bound elsewhere") {
+TEST_CASE("ellipsoid: exact along the shortest axis, a bound elsewhere") {
     CHECK(close(dist_of("ellipsoid([1, 1, 1]);", 2, 0, 0), 1));
-    // On an axis the bound is the true distance scaled by the radius ratio bound.
-    float d = dist_of("ellipsoid([2, 1, 1]);", 3, 0, 0);
-    CHECK(d > 0);
-    CHECK(d <= 1.0f + 1e-5f);
+    CHECK(close(dist_of("ellipsoid([2, 1, 3]);", 0, 3, 0), 2));
+    // Along a longer axis: (3/2 - 1) * 1 = 0.5, below the true distance 1.
+    CHECK(close(dist_of("ellipsoid([2, 1, 1]);", 3, 0, 0), 0.5));
     CHECK(dist_of("ellipsoid([2, 1, 1]);", 0.5, 0, 0) < 0);
 }
 
@@ -179,6 +178,7 @@ TEST_CASE("pyramid: base 1x1 on y = 0, apex at h") {
     CHECK(close(dist_of("pyramid(1);", 0, -1, 0), 1));    // below the base
     CHECK(close(dist_of("pyramid(1);", 1, -1, 0), std::sqrt(1.25)));  // below a base edge
     CHECK(close(dist_of("pyramid(1);", 1.5, 0, 0), 1.0));   // beside the base edge
+    CHECK(close(dist_of("pyramid(1);", 0, 0.05, 0), -0.05)); // inside, just above the base face
     CHECK(dist_of("pyramid(1);", 0, 0.2, 0) < 0);
 }
 

@@ -26,7 +26,8 @@ struct Rgb8 {
 
 inline std::vector<std::string> examples() {
     std::vector<std::string> out;
-    const fs::path dir = fs::path(SDFC_SOURCE_DIR) / "examples";
+    const char* env = std::getenv("SDFC_GPU_EXAMPLES");  // another folder of scenes (development)
+    const fs::path dir = env && *env ? fs::path(env) : fs::path(SDFC_SOURCE_DIR) / "examples";
     if (!fs::is_directory(dir)) return out;
     for (const auto& e : fs::directory_iterator(dir))
         if (e.is_regular_file() && (e.path().extension() == ".sdf" || e.path().extension() == ".vm")) out.push_back(e.path().string());

@@ -599,6 +599,8 @@ TEST_CASE("syntax errors: text and position", "[parser]") {
     CHECK(error_of("x = 1 # 2;") == "1:7: unexpected character '#'");
     CHECK(error_of("x = a & b;") == "1:7: unexpected character '&' (did you mean '&&'?)");
     CHECK(error_of("x = é;") == "1:5: unexpected character 'é'");
+    CHECK(error_of(std::string("x = 1;\n\0", 8)) == "2:1: unexpected character U+0000");
+    CHECK(error_of("x = 1;\x01") == "1:7: unexpected character U+0001");
     CHECK(error_of("x = 1 +;") == "1:8: expected an expression after the operator");
     CHECK(error_of("x = a ||\n;") == "2:1: expected an expression after '||'");
     CHECK(error_of("x = -;") == "1:6: expected an expression after '-'");

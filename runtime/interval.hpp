@@ -1,0 +1,87 @@
+// Interval arithmetic over the same bytecode as the batch VM, and per-region tape
+// simplification (Fidget / MPR): evaluating a Tape over a box gives an interval that
+// encloses every value the VM computes for a point of the box (bit for bit, rounding
+// included), and records for each min/max/select whether one side wins over the whole box.
+// simplify() then drops the losing sides and everything only they used, and re-allocates
+// registers, giving a shorter tape that computes exactly the same values inside the box.
+//
+// Unknown: an interval with a NaN end means "some point may be NaN" (or an input was
+// infinite); it never decides a choice and propagates through every op.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "compiler/program.hpp"
+
+namespace sdfc {
+
+struct Interval {
+    float lo, hi;
+};
+
+// Which side an op takes over a whole box (Min, Max, MinI, MaxI, Select).
+enum : uint8_t {
+    kChoiceBoth = 0,  // undecided: keep the op
+    kChoiceA = 1,     // operand a
+    kChoiceB = 2,     // operand b (MinI/MaxI: the immediate k)
+    kChoiceC = 3,     // operand c (Select)
+};
+bool is_choice_op(Op op);
+
+// The interval semantics of one op (scalar reference; the batch evaluator runs the same
+// code per lane). Inputs (VarX...) and Const return a / [k, k]. `choice` receives the side.
+Interval eval_interval(Op op, Interval a, Interval b, Interval c, float k, uint8_t* choice = nullptr);
+
+// A straight-line program with one output: a Program's output, or a shortened copy.
+struct Tape {
+    std::vector<Instr> code;
+    uint16_t out = 0;        // output register
+    uint32_t num_regs = 1;   // registers used (a VM register file this big suffices)
+    uint32_t choices = 0;    // instructions with is_choice_op, in order: their "slots"
+
+    static Tape from(const Program& p, int output = 0);
+    void recount();  // sets num_regs and choices from code
+};
+
+inline constexpr int kIvLanes = 64;
+
+// Evaluates a tape over up to kIvLanes boxes at once (structure of arrays, like the VM).
+// Sized for the largest tape it will see (registers and choice slots); no allocation after.
+class IntervalEvaluator {
+public:
+    IntervalEvaluator(uint32_t max_regs, uint32_t max_choices);
+
+    // Lane i's box is [xlo[i], xhi[i]] x [ylo[i], yhi[i]] x [zlo[i], zhi[i]]; n <= kIvLanes.
+    void eval(const Tape& t, const float* xlo, const float* xhi, const float* ylo, const float* yhi, const float* zlo,
+              const float* zhi, int n, float time = 0.0f);
+
+    Interval result(int lane) const { return {lo_[out_ * kIvLanes + lane], hi_[out_ * kIvLanes + lane]}; }
+    // Choice of slot s for lane i: choices()[s * stride() + i].
+    const uint8_t* choices() const { return choices_.get(); }
+    int stride() const { return stride_; }
+
+private:
+    uint32_t max_regs_, max_choices_;
+    std::unique_ptr<float[], void (*)(float*)> lo_store_, hi_store_;
+    float *lo_, *hi_;
+    std::unique_ptr<uint8_t[]> choices_;
+    int stride_ = 0;
+    uint16_t out_ = 0;
+};
+
+// Scratch for simplify(), reused across calls (one per thread).
+struct SimplifyScratch {
+    std::vector<uint16_t> bind;  // parent register -> new register (0xFFFF: not live)
+    std::vector<uint16_t> free_regs;
+    std::vector<Instr> rev;      // emitted instructions, last first
+};
+
+// The tape `parent` shortened for one box: the choices of `lane` (from an
+// IntervalEvaluator::eval of `parent`) replace decided ops by the winning operand, dead
+// code goes, and registers are re-allocated (backwards linear scan; an op's output may share
+// an operand's register, which the lane-wise VM allows). `out` computes exactly what
+// `parent` computes at every point of that box. Returns the number of instructions removed.
+size_t simplify(const Tape& parent, const uint8_t* choices, int stride, int lane, Tape& out, SimplifyScratch& s);
+
+}  // namespace sdfc

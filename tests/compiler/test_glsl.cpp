@@ -1,0 +1,354 @@
+// The GLSL backend: every opcode through the emitter, every example through every target,
+// each checked by glslangValidator when it is installed (else skipped with a warning), plus
+// the shape of each target's output.
+#include <unistd.h>
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "compiler/glsl.hpp"
+#include "compiler/glsl_emit.hpp"
+#include "lang/load.hpp"
+#include "support.hpp"
+
+namespace {
+
+using namespace sdfc;
+namespace fs = std::filesystem;
+
+std::string find_tool(const char* name) {
+    const char* path = std::getenv("PATH");
+    std::stringstream ss(path ? path : "/usr/bin:/bin");
+    std::string dir;
+    while (std::getline(ss, dir, ':')) {
+        fs::path p = fs::path(dir.empty() ? "." : dir) / name;
+        std::error_code ec;
+        if (fs::is_regular_file(p, ec) && access(p.c_str(), X_OK) == 0) return p.string();
+    }
+    return "";
+}
+
+const std::string& validator() {
+    static const std::string v = find_tool("glslangValidator");
+    return v;
+}
+
+fs::path scratch() {
+    static const fs::path d = [] {
+        fs::path p = fs::temp_directory_path() / fmt::format("sdfc-test-glsl-{}", getpid());
+        fs::create_directories(p);
+        return p;
+    }();
+    return d;
+}
+
+std::string read_text(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+// Runs glslangValidator on `src` (a complete fragment shader). Returns "" when accepted, else
+// its output.
+std::string validate(const std::string& src, const std::string& name) {
+    const fs::path file = scratch() / (name + ".frag"), log = scratch() / (name + ".log");
+    std::ofstream(file, std::ios::binary) << src;
+    const std::string cmd = fmt::format("'{}' '{}' > '{}' 2>&1", validator(), file.string(), log.string());
+    const int rc = std::system(cmd.c_str());
+    if (rc == 0) return "";
+    std::string out = read_text(log);
+    return out.empty() ? "glslangValidator exited with " + std::to_string(rc) : out;
+}
+
+bool skip_without_validator() {
+    if (!validator().empty()) return false;
+    WARN("SKIPPED: glslangValidator is not on PATH (Debian: glslang-tools), shaders are not validated");
+    return true;
+}
+
+// What shadertoy.com wraps around a shader.
+std::string shadertoy_prelude(const std::string& code) {
+    return "#version 300 es\nprecision highp float;\nprecision highp int;\nprecision mediump sampler3D;\n"
+           "uniform vec3 iResolution;\nuniform float iTime;\nuniform float iTimeDelta;\nuniform int iFrame;\n"
+           "uniform vec4 iMouse;\nuniform vec4 iDate;\nout vec4 shadertoy_out_color;\n" +
+           code + "\nvoid main() { mainImage(shadertoy_out_color, gl_FragCoord.xy); }\n";
+}
+
+std::string html_shader(const std::string& page) {
+    const std::string open = R"(<script type="x-shader/x-fragment" id="sdf-fragment">)";
+    const size_t a = page.find(open);
+    if (a == std::string::npos) return "";
+    const size_t b = page.find("</script>", a);
+    std::string s = page.substr(a + open.size(), b - a - open.size());
+    s.erase(0, s.find_first_not_of(" \t\r\n"));
+    return s;
+}
+
+std::vector<std::string> example_files() {
+    std::vector<std::string> out;
+    const fs::path dir = fs::path(SDFC_SOURCE_DIR) / "examples";
+    if (fs::is_directory(dir))
+        for (const auto& e : fs::directory_iterator(dir))
+            if (e.path().extension() == ".sdf" || e.path().extension() == ".vm") out.push_back(e.path().string());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+std::string glsl_of_text(const std::string& src, GlslTarget t) {
+    SourceManager sm;
+    const SourceFile& f = sm.add("scene.sdf", src);
+    InterpretOptions o;
+    o.time = std::nullopt;
+    Scene s = interpret_source(sm, f, o);
+    return emit_glsl(s, t);
+}
+
+std::string strip_outer(std::string s) {
+    if (s.size() >= 2 && s.front() == '(' && s.back() == ')') {
+        int depth = 0;
+        for (size_t i = 0; i < s.size(); ++i) {
+            if (s[i] == '(') ++depth;
+            else if (s[i] == ')' && --depth == 0 && i + 1 != s.size()) return s;
+        }
+        return s.substr(1, s.size() - 2);
+    }
+    return s;
+}
+
+// The expression an op's template gives for operands p.x, p.y, p.z and k = 0.5, derived here
+// from opcodes.def's text independently of the emitter.
+std::string template_expr(Op op) {
+    std::string t(op_info(op).glsl);
+    for (auto [ph, v] : {std::pair<const char*, const char*>{"{a}", "p.x"}, {"{b}", "p.y"}, {"{c}", "p.z"}, {"{k}", "0.5"}})
+        for (size_t pos; (pos = t.find(ph)) != std::string::npos;) t.replace(pos, 3, v);
+    return strip_outer(t);
+}
+
+// A program computing one `op` from the inputs (and k = 0.5).
+Program one_op_program(Op op) {
+    Program p;
+    p.code.push_back(Instr{Op::VarX, 0, 0});
+    p.code.push_back(Instr{Op::VarY, 0, 1});
+    p.code.push_back(Instr{Op::VarZ, 0, 2});
+    Instr in{op, 0, 3, 0, 1, 2};
+    in.k = 0.5f;
+    p.code.push_back(in);
+    p.locs.resize(p.code.size());
+    p.num_regs = 4;
+    p.outputs = {3};
+    p.output_names = {"out"};
+    return p;
+}
+
+}  // namespace
+
+TEST_CASE("glsl: float literals are valid GLSL and read back exactly", "[glsl]") {
+    CHECK(glsl::literal(2.0f) == "2.0");
+    CHECK(glsl::literal(0.5f) == "0.5");
+    CHECK(glsl::literal(100.0f) == "100.0");
+    CHECK(glsl::literal(1e-4f) == "1e-04");
+    CHECK(glsl::literal(-3.0f) == "(-3.0)");
+    CHECK(glsl::literal(-0.0f) == "(-0.0)");
+    CHECK(glsl::literal(std::numeric_limits<float>::infinity()) == "uintBitsToFloat(0x7f800000u)");
+    CHECK(glsl::literal(-std::numeric_limits<float>::infinity()) == "(-uintBitsToFloat(0x7f800000u))");
+    CHECK(glsl::literal(std::nanf("")) == "uintBitsToFloat(0x7fc00000u)");
+    for (float v : {0.1f, 1.0f / 3.0f, 3.4028235e38f, 1.17549435e-38f, 1e-45f, 123456789.0f, 0.70710678f, -2.5e-7f, 1e20f}) {
+        std::string s = glsl::literal(v);
+        INFO(s);
+        CHECK((s.find('.') != std::string::npos || s.find('e') != std::string::npos));
+        if (s[0] == '(') s = s.substr(1, s.size() - 2);
+        CHECK(std::strtof(s.c_str(), nullptr) == v);
+    }
+}
+
+TEST_CASE("glsl: negative constants print as subtraction, never as '--'", "[glsl]") {
+    CHECK(glsl::op_expr(Op::AddI, "x", "", "", -2.0f) == "(x - 2.0)");
+    CHECK(glsl::op_expr(Op::Neg, "(-2.0)", "", "", 0.0f) == "(-(-2.0))");
+    CHECK(glsl::op_expr(Op::Sub, "x", "(-1.5)", "", 0.0f) == "(x + 1.5)");
+    CHECK(glsl::op_expr(Op::MulI, "x", "", "", -2.0f) == "(x * (-2.0))");
+}
+
+TEST_CASE("glsl: every opcode goes through the emitter as its opcodes.def template", "[glsl][opcodes]") {
+    std::string all = "#version 300 es\nprecision highp float;\nprecision highp int;\nfloat sdf_time;\n";
+    all += om::kGlslNoise;
+    std::string sum;
+    std::vector<std::string> single;
+    for (int i = 0; i < kOpCount; ++i) {
+        const Op op = static_cast<Op>(i);
+        const OpInfo& info = op_info(op);
+        INFO("op " << info.mnemonic << " template " << info.glsl);
+        // The template's placeholders agree with the row's arity and immediate flag.
+        CHECK((std::string(info.glsl).find("{a}") != std::string::npos) == (info.arity >= 1));
+        CHECK((std::string(info.glsl).find("{b}") != std::string::npos) == (info.arity >= 2));
+        CHECK((std::string(info.glsl).find("{c}") != std::string::npos) == (info.arity >= 3));
+        CHECK((std::string(info.glsl).find("{k}") != std::string::npos) == info.has_imm);
+
+        glsl::FunctionSpec spec;
+        spec.signature = fmt::format("float op_{}(vec3 p)", info.mnemonic);
+        spec.var_prefix = "v";
+        spec.inline_limit = 1000;
+        const std::string fn = glsl::function(one_op_program(op), spec);
+        const std::string expect = template_expr(op);
+        INFO("emitted:\n" << fn << "expected to contain: " << expect);
+        CHECK(fn.find(expect) != std::string::npos);
+        all += fn;
+        sum += fmt::format(" + op_{}(q)", info.mnemonic);
+        single.push_back(fn);
+    }
+    all += "out vec4 color;\nvoid main() {\n    vec3 q = gl_FragCoord.xyz;\n    sdf_time = q.x;\n    color = vec4(0.0" + sum + ");\n}\n";
+    if (skip_without_validator()) return;
+    const std::string err = validate(all, "all_opcodes");
+    if (!err.empty()) {
+        // Name the culprits.
+        for (int i = 0; i < kOpCount; ++i) {
+            const std::string one = "#version 300 es\nprecision highp float;\nprecision highp int;\nfloat sdf_time;\n" + std::string(om::kGlslNoise) +
+                                    single[i] + "out vec4 color;\nvoid main() { color = vec4(op_" + std::string(op_info(static_cast<Op>(i)).mnemonic) +
+                                    "(gl_FragCoord.xyz)); }\n";
+            const std::string e = validate(one, fmt::format("op_{}", i));
+            INFO("op " << op_info(static_cast<Op>(i)).mnemonic << ":\n" << e);
+            CHECK(e == "");
+        }
+    }
+    INFO(err);
+    CHECK(err == "");
+}
+
+TEST_CASE("glsl: every example compiles for every target", "[glsl][examples]") {
+    const auto files = example_files();
+    if (files.empty()) {
+        WARN("no examples/*.sdf yet");
+        return;
+    }
+    const bool have = !skip_without_validator();
+    for (const std::string& path : files) {
+        const std::string stem = fs::path(path).stem().string();
+        INFO("example " << path);
+        SourceManager sm;
+        InterpretOptions o;
+        o.time = std::nullopt;
+        Scene s = load_scene(sm, path, o);
+
+        const std::string st = emit_glsl(s, GlslTarget::Shadertoy);
+        CHECK(st.find("#version") == std::string::npos);
+        CHECK(st.find("uniform") == std::string::npos);
+        CHECK(st.find("void main(") == std::string::npos);
+        CHECK(st.find("precision ") == std::string::npos);
+        CHECK(st.find("void mainImage(out vec4 fragColor, in vec2 fragCoord)") != std::string::npos);
+        CHECK(st.find("float map(vec3 p)") != std::string::npos);
+        CHECK(st.find("Material sdf_material(vec3 p)") != std::string::npos);
+
+        const std::string g330 = emit_glsl(s, GlslTarget::Glsl330);
+        CHECK(g330.rfind("#version 330 core\n", 0) == 0);
+        CHECK(g330.find("uniform vec2 uResolution;") != std::string::npos);
+        CHECK(g330.find("void main()") != std::string::npos);
+
+        const std::string page = emit_glsl(s, GlslTarget::Html);
+        const std::string hs = html_shader(page);
+        CHECK(hs.rfind("#version 300 es\n", 0) == 0);
+        if (!have) continue;
+        std::string e = validate(shadertoy_prelude(st), stem + ".shadertoy");
+        INFO("shadertoy:\n" << e);
+        CHECK(e == "");
+        e = validate(g330, stem + ".glsl330");
+        INFO("glsl330:\n" << e);
+        CHECK(e == "");
+        e = validate(hs, stem + ".html");
+        INFO("html:\n" << e);
+        CHECK(e == "");
+    }
+}
+
+TEST_CASE("glsl: shadertoy output is paste-ready and readable", "[glsl]") {
+    const std::string st = glsl_of_text(
+        "camera(position = [0, 2, 6 + sin(time)], target = [0, 0, 0]);\n"
+        "light(position = [3, 4, 5], intensity = 20);\n"
+        "translate([0, 0.5 * time, 0]) sphere(2);\n"
+        "displace(0.1, 2) box(1);\n",
+        GlslTarget::Shadertoy);
+    CHECK(st.find("#version") == std::string::npos);
+    CHECK(st.find("uniform") == std::string::npos);
+    CHECK(st.find("void main(") == std::string::npos);
+    CHECK(st.find("iTime") != std::string::npos);
+    CHECK(st.find("iMouse") != std::string::npos);
+    CHECK(st.find("iResolution") != std::string::npos);
+    // `time` is symbolic: used by the distance and the camera.
+    const size_t map = st.find("float map(vec3 p)");
+    REQUIRE(map != std::string::npos);
+    CHECK(st.find("sdf_time", map) < st.find("\n}\n", map));
+    const size_t set = st.find("void sdf_settings()");
+    REQUIRE(set != std::string::npos);
+    CHECK(st.find("sdf_time", set) < st.find("\n}\n", set));
+    // Comments name the script lines; constants are float literals; noise comes along.
+    CHECK(st.find("// scene.sdf:4  displace(0.1, 2) box(1);") != std::string::npos);
+    CHECK(st.find("sdf_noise(") != std::string::npos);
+    CHECK(st.find("float sdf_noise(vec3 q)") != std::string::npos);
+    CHECK(st.find("2.0") != std::string::npos);
+    if (skip_without_validator()) return;
+    const std::string e = validate(shadertoy_prelude(st), "readable");
+    INFO(e);
+    CHECK(e == "");
+}
+
+TEST_CASE("glsl: targets for scenes with every renderer feature validate", "[glsl]") {
+    const char* scenes[] = {
+        // default lights, default camera
+        "sphere(1);",
+        // glass, mirror, emission, soft shadows, directional light, many bounces
+        "light(position = [4, 6, 5], intensity = 50, radius = 0.5);\n"
+        "light(direction = [-1, -2, -0.5], intensity = 0.6);\n"
+        "render(max_bounces = 5, samples = 3);\n"
+        "plane();\n"
+        "material(color = [0.9, 0.95, 1], transparency = 0.9, ior = 1.5) sphere(1);\n"
+        "translate([2, 0, 0]) material(reflect = 0.8, emission = [0.1, 0, 0]) box(1);\n",
+        // orthographic, cone AA, no shadows, no AO, zero bounces
+        "camera(position = [5, 5, 5], projection = \"orthographic\", ortho_height = 4);\n"
+        "render(aa = \"cone\", shadows = false, ao = false, max_bounces = 0);\n"
+        "torus(1, 0.3);\n",
+    };
+    if (skip_without_validator()) return;
+    int i = 0;
+    for (const char* src : scenes) {
+        INFO(src);
+        for (GlslTarget t : {GlslTarget::Shadertoy, GlslTarget::Glsl330, GlslTarget::Html}) {
+            std::string code = glsl_of_text(src, t);
+            if (t == GlslTarget::Shadertoy) code = shadertoy_prelude(code);
+            if (t == GlslTarget::Html) code = html_shader(code);
+            const std::string e = validate(code, fmt::format("feature{}_{}", i, static_cast<int>(t)));
+            INFO("target " << static_cast<int>(t) << ":\n" << e);
+            CHECK(e == "");
+        }
+        ++i;
+    }
+}
+
+TEST_CASE("glsl: the html page is self-contained", "[glsl][html]") {
+    const std::string page = glsl_of_text("sphere(1);", GlslTarget::Html);
+    CHECK(page.rfind("<!DOCTYPE html>", 0) == 0);
+    CHECK(page.find("getContext('webgl2'") != std::string::npos);
+    CHECK(page.find("WebGL2 is not available") != std::string::npos);
+    CHECK(page.find("<script src") == std::string::npos);
+    CHECK(page.find("<link") == std::string::npos);
+    CHECK(page.find("http://") == std::string::npos);
+    CHECK(page.find("https://") == std::string::npos);
+    CHECK(page.find("@SHADER@") == std::string::npos);
+    CHECK(page.find("capture") != std::string::npos);
+    CHECK(page.find("id=\"play\"") != std::string::npos);
+    CHECK(page.find("id=\"time\"") != std::string::npos);
+    CHECK(page.find("id=\"scale\"") != std::string::npos);
+    // Every byte ASCII-safe for the shader compiler, even with non-ASCII script comments.
+    const std::string p2 = glsl_of_text("// caf\xc3\xa9 \xe2\x80\x94 </script>\nsphere(1); // \xc3\xa9\n", GlslTarget::Html);
+    const std::string hs = html_shader(p2);
+    for (char c : hs) CHECK(static_cast<unsigned char>(c) < 0x80);
+    CHECK(hs.find("</") == std::string::npos);
+}
