@@ -53,6 +53,41 @@ std::string script_name(const Scene& s) {
     return "scene";
 }
 
+glm::vec3 const3(const Graph& g, const Vec3N& v, glm::vec3 dflt) {
+    glm::vec3 r = dflt;
+    for (int i = 0; i < 3; ++i)
+        if (v[i] != kNoNode && g.is_const(v[i])) r[i] = g.const_value(v[i]);
+    return r;
+}
+
+// A Lipschitz estimate for a raw field over a box, as runtime/tracer.cpp makes it: the largest
+// gradient norm (forward differences) on a 16^3 grid among the tenth of the points with the
+// smallest |f|, times 1.5.
+float estimate_lipschitz(const Program& prog, const glm::vec3& lo, const glm::vec3& hi) {
+    constexpr int kGrid = 16;
+    const glm::vec3 ext = hi - lo;
+    const float m = std::max(ext.x, std::max(ext.y, ext.z));
+    if (!std::isfinite(m)) return 1.0f;
+    const float e = 1e-3f * std::max(m, 1e-6f);
+    std::vector<std::pair<float, float>> samples;  // (|f|, |grad f|)
+    for (int k = 0; k < kGrid; ++k)
+        for (int j = 0; j < kGrid; ++j)
+            for (int i = 0; i < kGrid; ++i) {
+                const glm::vec3 p = lo + ext * (glm::vec3(i, j, k) + 0.5f) / static_cast<float>(kGrid);
+                float f[4];
+                for (int q = 0; q < 4; ++q)
+                    f[q] = eval_scalar(prog, p.x + (q == 1 ? e : 0.0f), p.y + (q == 2 ? e : 0.0f), p.z + (q == 3 ? e : 0.0f), 0.0f)[0];
+                const glm::vec3 gr(f[1] - f[0], f[2] - f[0], f[3] - f[0]);
+                const float gn = glm::length(gr) / e;
+                if (std::isfinite(gn) && std::isfinite(f[0])) samples.emplace_back(std::fabs(f[0]), gn);
+            }
+    if (samples.empty()) return 1.0f;
+    std::sort(samples.begin(), samples.end());
+    float l = 0.0f;
+    for (size_t i = 0; i < (samples.size() + 9) / 10; ++i) l = std::max(l, samples[i].second);
+    return l > 1e-6f ? 1.5f * l : 1.0f;
+}
+
 struct Parts {
     std::string name;       // script file name
     std::string code;       // everything but the entry point (no #version, no uniforms)
@@ -93,7 +128,8 @@ Parts generate(const Scene& scene) {
     g.set_loc(saved);
 
     const RenderSettings& rs = scene.render;
-    const bool cone = rs.aa == "cone";
+    const bool raw = scene.raw_field && !dist.outputs.empty();
+    const bool cone = rs.aa == "cone" && !raw;
     const int samples = cone ? 1 : std::clamp(rs.samples, 1, 4096);
     const int max_steps = std::max(rs.max_steps, 1);
     const int max_bounces = std::clamp(rs.max_bounces, 0, 64);
@@ -105,12 +141,25 @@ Parts generate(const Scene& scene) {
     Bounds b = shape_bounds(g, *scene.root);
     bool clip = false;
     glm::vec3 lo(0.0f), hi(0.0f);
-    if (b.finite()) {
+    float raw_inv_l = 1.0f, raw_max_step = 0.05f;
+    if (raw && !b.finite()) {
+        // No bounds and no distance: the cube around the camera's target whose half-size is
+        // the camera's distance to it (as the CPU renderer does; a .vm model's camera is constant).
+        const glm::vec3 pos = const3(g, cam.position, {0, 0, 5}), target = const3(g, cam.target, {0, 0, 0});
+        const float r = std::max(glm::length(pos - target), 1.0f);
+        lo = target - glm::vec3(r);
+        hi = target + glm::vec3(r);
+        clip = std::isfinite(r);
+    } else if (b.finite()) {
         const glm::vec3 ext = b.hi - b.lo;
         const float m = 1e-3f * std::max(std::max(ext.x, std::max(ext.y, ext.z)), 0.0f) + 1e-3f;
         lo = b.lo - glm::vec3(m);
         hi = b.hi + glm::vec3(m);
         clip = lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z;
+    }
+    if (raw) {
+        raw_inv_l = 1.0f / estimate_lipschitz(dist, lo, hi);
+        raw_max_step = clip ? glm::length(hi - lo) / 48.0f : 0.05f * max_dist;
     }
 
     Parts out;
@@ -123,12 +172,12 @@ Parts generate(const Scene& scene) {
         "const float SDF_MAX_DIST = {};\n"
         "const float SDF_EPSILON = {};\n"
         "const bool SDF_SHADOWS = {};\n"
-        "const bool SDF_AO = {};\n"
+        "const bool SDF_AO = {};  // ambient occlusion\n"
         "const int SDF_MAX_BOUNCES = {};\n"
         "const bool SDF_CONE = {};  // cone-traced anti-aliasing (render(aa = \"cone\"))\n"
         "const bool SDF_2D = {};  // a 2D model: the Prospero image\n"
         "const bool SDF_ORTHO = {};  // orthographic camera\n",
-        max_steps, literal(max_dist), literal(eps), rs.shadows ? "true" : "false", rs.ao ? "true" : "false", max_bounces,
+        max_steps, literal(max_dist), literal(eps), rs.shadows ? "true" : "false", rs.ao && !raw ? "true" : "false", max_bounces,
         cone ? "true" : "false", scene.is_2d ? "true" : "false", cam.orthographic ? "true" : "false");
     c += fmt::format("const int SDF_SAMPLES = {};  // samples per pixel\nconst vec2 SDF_OFFSETS[SDF_SAMPLES] = vec2[SDF_SAMPLES](", samples);
     for (int i = 0; i < samples; ++i) {
@@ -142,6 +191,10 @@ Parts generate(const Scene& scene) {
                      literal(1.0f / static_cast<float>(samples)), literal(1e-3f / static_cast<float>(samples)));
     c += fmt::format("const bool SDF_CLIP = {};  // rays are clipped to the scene's bounding box\n", clip ? "true" : "false");
     c += fmt::format("const vec3 SDF_LO = {};\nconst vec3 SDF_HI = {};\n", vec3_lit(lo.x, lo.y, lo.z), vec3_lit(hi.x, hi.y, hi.z));
+    c += "const float SDF_RELAX = 1.5;  // over-relaxed sphere tracing\n";
+    c += fmt::format("const bool SDF_RAW = {};  // a raw field (.vm model): no distance bound, sign-change marching\n"
+                     "const float SDF_RAW_INV_LIPSCHITZ = {};\nconst float SDF_RAW_MAX_STEP = {};\n",
+                     raw ? "true" : "false", literal(raw_inv_l), literal(raw_max_step));
     c += fmt::format("const int SDF_NUM_LIGHTS = {};\nconst bool SDF_DEFAULT_LIGHTS = {};  // the script has no light: the default rig\n\n",
                      nlights, scene.lights.empty() ? "true" : "false");
     c += glsl::kRendererHead;

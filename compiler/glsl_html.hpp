@@ -27,10 +27,11 @@ inline constexpr const char* kHtmlTemplate = R"HTML(<!DOCTYPE html>
         border-radius: 4px; padding: 2px 8px; }
   #ui input[type=range] { flex: 1 1 160px; min-width: 100px; }
   #ui .dim { color: #aaa; }
-  #message { display: none; position: fixed; left: 50%; top: 40%; transform: translate(-50%, -50%);
-        max-width: 36em; padding: 16px 20px; border-radius: 8px; background: #fff; color: #222;
+  #message { display: none; position: fixed; left: 50%; top: 50%; transform: translate(-50%, -50%);
+        box-sizing: border-box; width: 36em; max-width: 94vw; max-height: 94vh; overflow: auto;
+        padding: 16px 20px; border-radius: 8px; background: #fff; color: #222;
         font: 15px/1.5 system-ui, sans-serif; white-space: pre-wrap; box-shadow: 0 4px 24px rgba(0,0,0,0.5); }
-  body.capture #ui { display: none; }
+  body.capture #ui, body.failed #ui { display: none; }
 </style>
 </head>
 <body>
@@ -66,6 +67,7 @@ inline constexpr const char* kHtmlTemplate = R"HTML(<!DOCTYPE html>
   function fail(text) {
     message.textContent = text;
     message.style.display = 'block';
+    document.body.className = 'failed';
     document.title = 'sdfc preview: error';
   }
   var gl = null;

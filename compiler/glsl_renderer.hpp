@@ -7,7 +7,8 @@
 // It expects, defined before it (compiler/glsl.cpp writes them from the scene):
 //   const int SDF_MAX_STEPS, SDF_MAX_BOUNCES, SDF_SAMPLES, SDF_NUM_LIGHTS;
 //   const float SDF_MAX_DIST, SDF_EPSILON, SDF_MIN_WEIGHT, SDF_SAMPLE_WEIGHT;
-//   const bool SDF_SHADOWS, SDF_AO, SDF_CONE, SDF_2D, SDF_CLIP, SDF_DEFAULT_LIGHTS, SDF_ORTHO;
+//   const bool SDF_SHADOWS, SDF_AO, SDF_CONE, SDF_2D, SDF_CLIP, SDF_DEFAULT_LIGHTS, SDF_ORTHO, SDF_RAW;
+//   const float SDF_RELAX, SDF_RAW_INV_LIPSCHITZ, SDF_RAW_MAX_STEP;
 //   const vec3 SDF_LO, SDF_HI; const vec2 SDF_OFFSETS[SDF_SAMPLES];
 //   float map(vec3 p); Material sdf_material(vec3 p); void sdf_settings();
 //   and the globals below that sdf_settings() assigns.
@@ -154,20 +155,84 @@ void sdf_clip_ray(vec3 o, vec3 d, inout float t_min, inout float t_max) {
     if (!(t_min <= t_max)) t_min = sdf_inf();
 }
 
-// Sphere tracing (on -d inside a solid). Hit when d < epsilon * max(path, 1); a ray out of
-// steps hits when within one pixel footprint.
-bool sdf_march(vec3 o, vec3 d, float tmin, float tmax, float t0, bool inside, out float t) {
+// Raw fields (.vm models, no distance bound): steps of |f| / L (L a Lipschitz estimate made by
+// the compiler as the CPU renderer makes it), clamped to [one pixel footprint, SDF_RAW_MAX_STEP];
+// a sign change is refined by bisection to the outside end of the bracket. `shadow`: any sign
+// change is a hit.
+bool sdf_march_raw(vec3 o, vec3 d, float tmin, float tmax, float t0, bool inside, bool shadow, out float t) {
     t = tmin;
     if (!(t <= tmax)) { t = tmax; return false; }
+    float sg = inside ? -1.0 : 1.0;
+    float prev = -1.0, lo = 0.0, hi = 0.0, bisect = 0.0;
     for (int steps = 1; steps <= SDF_MAX_STEPS; ++steps) {
-        float dist = map(o + t * d);
-        float s = inside ? -dist : dist;
+        float s = sg * map(o + t * d);
         float path = t0 + t;
-        if (s < sdf_thr(path)) return true;
-        if (isnan(s)) return false;
-        if (steps >= SDF_MAX_STEPS) return s < sdf_footprint(path);
-        t += s;
-        if (!(t <= tmax)) return false;
+        bool done = false, hit = false;
+        if (bisect > 0.0) {
+            if (s < 0.0) hi = t;
+            else lo = t;
+            bisect += 1.0;
+            if (bisect > 12.0 || hi - lo < sdf_thr(path)) {
+                t = lo;
+                done = hit = true;
+            } else {
+                t = 0.5 * (lo + hi);
+            }
+        } else if (s <= 0.0) {
+            if (s == 0.0 || prev < 0.0 || shadow) {
+                done = hit = true;
+            } else {
+                lo = prev;
+                hi = t;
+                bisect = 1.0;
+                t = 0.5 * (lo + hi);
+            }
+        } else {
+            float fp = sdf_footprint(path), step = fp;
+            if (!isnan(s)) {
+                float v = s * SDF_RAW_INV_LIPSCHITZ;
+                step = v < fp ? fp : (SDF_RAW_MAX_STEP < v ? SDF_RAW_MAX_STEP : v);
+            }
+            prev = t;
+            t = t + step;
+            done = !(t <= tmax);
+        }
+        if (!done && steps >= SDF_MAX_STEPS) {
+            done = true;
+            hit = bisect > 0.0;
+            if (hit) t = lo;
+        }
+        if (done) return hit;
+    }
+    return false;
+}
+
+// Over-relaxed sphere tracing (Keinert et al. 2014: omega = 1.5, back to 1 when consecutive
+// unbounding spheres stop overlapping), on -d inside a solid. Hit when d < epsilon *
+// max(path, 1); a ray out of steps hits when within one pixel footprint.
+bool sdf_march(vec3 o, vec3 d, float tmin, float tmax, float t0, bool inside, out float t) {
+    if (SDF_RAW) return sdf_march_raw(o, d, tmin, tmax, t0, inside, false, t);
+    t = tmin;
+    if (!(t <= tmax)) { t = tmax; return false; }
+    float sg = inside ? -1.0 : 1.0;
+    float om = SDF_RELAX, pr = 0.0, sl = 0.0;
+    for (int steps = 1; steps <= SDF_MAX_STEPS; ++steps) {
+        float s = sg * map(o + t * d);
+        float r = abs(s);
+        bool fail = om > 1.0 && r + pr < sl;
+        float step = fail ? (1.0 - om) * sl : om * s;
+        om = fail ? 1.0 : om;
+        sl = step;
+        pr = r;
+        bool stop = (s < SDF_EPSILON * max(t0 + t, 1.0) && !fail) || steps >= SDF_MAX_STEPS;
+        float tn = t + step;
+        bool past = !(tn <= tmax);
+        float last = fail ? sdf_inf() : s;
+        t = stop ? t : tn;
+        if (stop || past) {
+            float path = t0 + t;
+            return last < sdf_thr(path) || (steps >= SDF_MAX_STEPS && last < sdf_footprint(path));
+        }
     }
     return false;
 }
@@ -253,37 +318,45 @@ float sdf_penumbra(float res) {
     return 0.25 * (1.0 + res) * (1.0 + res) * (2.0 - res);
 }
 
-// Visibility of a light along [tmin, tmax]: hard (any hit = 0) or, with a light radius
-// (angular width w), Quilez's soft penumbra with the closest-approach refinement.
+// Visibility of a light along [tmin, tmax]: hard (any hit = 0; over-relaxed like
+// sdf_march), or, with a light radius (angular width w), Quilez's soft penumbra with the
+// closest-approach refinement, marching through occluders.
 float sdf_shadow(vec3 o, vec3 l, float tmin, float tmax, float t0, float w, bool soft) {
     float t = tmin;
     if (!(t <= tmax)) return 1.0;
-    float res = 1.0, prev = 1e20;
+    if (SDF_RAW) return sdf_march_raw(o, l, tmin, tmax, t0, false, true, t) ? 0.0 : 1.0;
+    float om = SDF_RELAX, pr = 0.0, sl = 0.0;  // hard
+    float res = 1.0, prev = 1e20;              // soft
     for (int steps = 1; steps <= SDF_MAX_STEPS; ++steps) {
         float h = map(o + t * l);
-        float path = t0 + t;
+        float thr = SDF_EPSILON * max(t0 + t, 1.0);
         if (!soft) {
-            if (h < sdf_thr(path)) return 0.0;
-            if (isnan(h)) return 1.0;
-            if (steps >= SDF_MAX_STEPS) return h < sdf_footprint(path) ? 0.0 : 1.0;
-            t += h;
-            if (!(t < tmax)) return 1.0;
-        } else {
-            if (isnan(h)) return sdf_penumbra(res);
-            float est;
-            if (h > 0.0) {
-                float y = min(h * h / (2.0 * prev), 0.999 * h);
-                float dd = sqrt(h * h - y * y);
-                est = dd / (w * max(t - y, 1e-20));
-                prev = h;
-            } else {
-                est = h / (w * max(t, 1e-20));
-                prev = 1e20;
+            float r = abs(h);
+            bool fail = om > 1.0 && r + pr < sl;
+            float step = fail ? (1.0 - om) * sl : om * h;
+            om = fail ? 1.0 : om;
+            sl = step;
+            pr = r;
+            bool stop = (h < thr && !fail) || steps >= SDF_MAX_STEPS;
+            float tn = t + step;
+            bool past = !(tn < tmax);
+            float last = fail ? sdf_inf() : h;
+            t = stop ? t : tn;
+            if (stop || past) {
+                float path = t0 + t;
+                return (last < sdf_thr(path) || (steps >= SDF_MAX_STEPS && last < sdf_footprint(path))) ? 0.0 : 1.0;
             }
-            res = min(res, est);
-            if (res <= -1.0 || steps >= SDF_MAX_STEPS) return sdf_penumbra(res);
-            t += h > 0.0 ? max(h, sdf_thr(path)) : max(0.25 * w * t, sdf_thr(path));
-            if (!(t < tmax)) return sdf_penumbra(res);
+        } else {
+            bool pos = h > 0.0;
+            float y = min(h * h / (2.0 * prev), 0.999 * h);
+            float dd = sqrt(max(h * h - y * y, 0.0));
+            float est = pos ? dd / (w * max(t - y, 1e-20)) : h / (w * max(t, 1e-20));
+            res = est < res ? est : res;  // NaN keeps res
+            prev = pos ? h : 1e20;
+            float step = pos ? max(h, thr) : max(0.25 * w * t, thr);
+            float tn = t + step;
+            t = tn;
+            if (isnan(h) || res <= -1.0 || steps >= SDF_MAX_STEPS || !(tn < tmax)) return sdf_penumbra(res);
         }
     }
     return 1.0;
@@ -304,7 +377,7 @@ vec3 sdf_local_light(vec3 P, vec3 D, vec3 N, float path, Material m, vec3 lw) {
             for (int j = 0; j < 5; ++j) {
                 float s = 0.01 + 0.12 * float(j) / 4.0;
                 float d = map(P + N * s);
-                if (!isnan(d)) occ += (s - min(d, s + 1.0)) * sca;
+                if (d < s) occ += (s - d) * sca;  // (NaN adds nothing)
                 sca *= 0.95;
             }
             ao = sdf_clamp01(1.0 - 3.0 * occ);
@@ -369,14 +442,16 @@ struct SdfRay {
 };
 const int SDF_STACK = SDF_MAX_BOUNCES + 6;
 
-// One primary sample of weight w0: the first hit, then mirror/glass bounces depth first.
+// One primary sample of weight w0: the first hit, then mirror/glass bounces depth first. (The
+// primary ray goes through the same stack as the bounces, so map() is inlined at one marching
+// call site.)
 vec3 sdf_trace(vec3 O, vec3 D, float w0) {
     vec3 acc = vec3(0.0);
     SdfRay stack[SDF_STACK];
     int sp = 0;
     float tmin = 0.0, tmax = SDF_MAX_DIST;
     sdf_clip_ray(O, D, tmin, tmax);
-    float t;
+    float t = 0.0;
     if (SDF_CONE) {
         float ev_t[4], ev_w[4], trans;
         int ev_n;
@@ -387,8 +462,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
         if (hit) stack[sp++] = SdfRay(O, D, vec3(rest), 0.0, 0.0, 0.0, t, false, true, 0);
         else acc += sdf_background * rest;
     } else {
-        if (sdf_march(O, D, tmin, tmax, 0.0, false, t)) stack[sp++] = SdfRay(O, D, vec3(w0), 0.0, 0.0, 0.0, t, false, true, 0);
-        else acc += sdf_background * w0;
+        stack[sp++] = SdfRay(O, D, vec3(w0), tmin, tmax, 0.0, 0.0, false, false, 0);  // marched below
     }
     for (int guard = 0; guard < 4096 && sp > 0; ++guard) {
         SdfRay r = stack[--sp];

@@ -112,6 +112,7 @@ ShapePtr Interp::union_of(std::vector<ShapePtr> shapes, Loc loc) {
 
 ShapePtr Interp::to_shape(const Value& v, Loc loc, const char* what) {
     if (v.t == VT::Shape) return v.shape;
+    if (v.t == VT::None) return union_of({}, loc);
     if (v.t == VT::Modifier) fail(loc, fmt::format("{} needs a shape to apply to", v.mod->name));
     fail(loc, fmt::format("{} must be a shape, not {}", what, describe(v)));
 }
@@ -364,6 +365,9 @@ Value Interp::eval_block(const ast::Block& b, Env* env, bool field_scope) {
         }
         shapes.push_back(r.shape);
     }
+    // A block that adds nothing (a loop body of assignments in a field) has no value; where
+    // a shape is needed, to_shape takes it as the empty shape.
+    if (shapes.empty()) return Value{};
     return Value::of_shape(union_of(std::move(shapes), b.loc));
 }
 

@@ -91,7 +91,8 @@ const SourceFile& SourceManager::load(const std::string& path, Loc from, size_t 
 
 std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates) {
     std::string best;
-    size_t best_d = std::max<size_t>(2, name.size() / 3) + 1;
+    // Close enough to be a typo: at most a third of the name wrong, and never all of it.
+    size_t best_d = std::min(std::max<size_t>(1, name.size() / 3), name.size() - 1) + 1;
     for (const auto& c : candidates) {
         std::vector<size_t> prev(c.size() + 1), cur(c.size() + 1);
         for (size_t j = 0; j <= c.size(); ++j) prev[j] = j;

@@ -34,14 +34,24 @@ bool is_choice_op(Op op);
 Interval eval_interval(Op op, Interval a, Interval b, Interval c, float k, uint8_t* choice = nullptr);
 
 // A straight-line program with one output: a Program's output, or a shortened copy.
+// link() adds what simplify() needs to visit only the live part of a tape: for every
+// operand the index of the instruction that defined its value (registers are reused, so
+// this is the last earlier write of the register), and each choice op's slot.
 struct Tape {
+    static constexpr uint32_t kNone = 0xFFFFFFFFu;
     std::vector<Instr> code;
     uint16_t out = 0;        // output register
     uint32_t num_regs = 1;   // registers used (a VM register file this big suffices)
     uint32_t choices = 0;    // instructions with is_choice_op, in order: their "slots"
+    // link():
+    std::vector<uint32_t> def;   // 3 per instruction: defining instruction of a, b, c (kNone: unused)
+    std::vector<uint32_t> slot;  // per instruction: its choice slot (kNone: not a choice op)
+    uint32_t out_def = kNone;    // the instruction defining the output
+    bool linked = false;
 
     static Tape from(const Program& p, int output = 0);
     void recount();  // sets num_regs and choices from code
+    void link();     // fills def, slot, out_def (needs scratch the size of num_regs)
 };
 
 inline constexpr int kIvLanes = 64;
@@ -72,16 +82,20 @@ private:
 
 // Scratch for simplify(), reused across calls (one per thread).
 struct SimplifyScratch {
-    std::vector<uint16_t> bind;  // parent register -> new register (0xFFFF: not live)
+    std::vector<uint64_t> live;     // bit per parent instruction: value needed, not yet visited
+    std::vector<uint16_t> bind;     // per parent instruction: register of its value (when live)
     std::vector<uint16_t> free_regs;
-    std::vector<Instr> rev;      // emitted instructions, last first
+    std::vector<Instr> rev;         // emitted instructions, last first
+    std::vector<uint32_t> last_def; // link(): per register
 };
 
-// The tape `parent` shortened for one box: the choices of `lane` (from an
+// The tape `parent` (linked) shortened for one box: the choices of `lane` (from an
 // IntervalEvaluator::eval of `parent`) replace decided ops by the winning operand, dead
-// code goes, and registers are re-allocated (backwards linear scan; an op's output may share
-// an operand's register, which the lane-wise VM allows). `out` computes exactly what
-// `parent` computes at every point of that box. Returns the number of instructions removed.
-size_t simplify(const Tape& parent, const uint8_t* choices, int stride, int lane, Tape& out, SimplifyScratch& s);
+// code goes, and registers are re-allocated (backwards linear scan; an op's output may
+// share an operand's register, which the lane-wise VM allows). Only live instructions are
+// visited (def links), so the cost is about the size of the result. `out` computes exactly
+// what `parent` computes at every point of that box; it is not linked (call link() before
+// simplifying it further).
+void simplify(const Tape& parent, const uint8_t* choices, int stride, int lane, Tape& out, SimplifyScratch& s);
 
 }  // namespace sdfc

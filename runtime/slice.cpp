@@ -82,27 +82,4 @@ Image render_slice(const CompiledScene& scene, const SliceOptions& opt) {
     return img;
 }
 
-Image render_2d(const CompiledScene& scene, int w, int h, int threads, bool /*baseline*/, RenderStats* stats) {
-    Image img(w, h, 3);
-    for_rows(scene.distance, h, threads, [&](Evaluator& ev, int y) {
-        float xs[kBatch], ys[kBatch], zs[kBatch] = {};
-        float yv = h > 1 ? 1.0f - 2.0f * float(y) / float(h - 1) : 0.0f;
-        for (int x0 = 0; x0 < w; x0 += kBatch) {
-            int n = std::min(kBatch, w - x0);
-            for (int i = 0; i < n; ++i) {
-                xs[i] = w > 1 ? -1.0f + 2.0f * float(x0 + i) / float(w - 1) : 0.0f;
-                ys[i] = yv;
-            }
-            ev.eval(xs, ys, zs, n, scene.time);
-            const float* d = ev.output(0);
-            for (int i = 0; i < n; ++i) {
-                float v = d[i] < 0.0f ? 1.0f : 0.0f;
-                for (int c = 0; c < 3; ++c) img.at(x0 + i, y, c) = v;
-            }
-        }
-    });
-    if (stats) stats->distance_points = uint64_t(w) * uint64_t(h);
-    return img;
-}
-
 }  // namespace sdfc

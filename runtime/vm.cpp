@@ -103,9 +103,14 @@ static inline void run(const Instr* code, const Instr* end, float* base, const f
 }
 
 void Evaluator::eval(const float* x, const float* y, const float* z, int n, float time) {
+    eval_code(program_->code.data(), program_->code.size(), x, y, z, n, time);
+}
+
+void Evaluator::eval_code(const Instr* code, size_t count, const float* x, const float* y, const float* z, int n,
+                          float time) {
+    if (n <= 0) return;
     const int m = (n + kGroup - 1) / kGroup * kGroup;  // lanes computed
-    const Instr* code = program_->code.data();
-    const Instr* end = code + program_->code.size();
+    const Instr* end = code + count;
     if (m == kBatch) run<true>(code, end, regs_, x, y, z, n, m, time);
     else run<false>(code, end, regs_, x, y, z, n, m, time);
 }

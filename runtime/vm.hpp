@@ -22,6 +22,13 @@ public:
     void eval(const float* x, const float* y, const float* z, int n, float time = 0.0f);
     const float* output(int i) const { return reg(program_->outputs[static_cast<size_t>(i)]); }
 
+    // Runs `count` instructions of another tape (e.g. a simplified one, runtime/interval.hpp)
+    // on this register file; it must use at most program().num_regs registers. Read the
+    // result with reg_data(its output register).
+    void eval_code(const Instr* code, size_t count, const float* x, const float* y, const float* z, int n,
+                   float time = 0.0f);
+    const float* reg_data(uint32_t r) const { return reg(r); }
+
     // Convenience: one point, first output.
     float eval1(float x, float y, float z, float time = 0.0f);
 

@@ -118,7 +118,8 @@ menger(4);
     auto c = test::compile_text(menger);
     // The centre hole goes through along every axis; the corner cube is solid.
     CHECK(test::dist(c->cs, 0, 0, 0) > 0);
-    CHECK(test::dist(c->cs, 0.9, 0.9, 0.9) < 0);
+    CHECK(test::dist(c->cs, 0.99f, 0.99f, 0.99f) < 0);
+    CHECK(test::dist(c->cs, 0.9f, 0.9f, 0.9f) > 0);  // inside a level-3 hole
     CHECK(close(test::dist(c->cs, 3, 0.9, 0.9), 2));
 }
 

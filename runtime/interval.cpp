@@ -1,0 +1,614 @@
+// Interval semantics of every opcode, the batch interval evaluator and tape simplification.
+//
+// Exactness. The VM's arithmetic is IEEE single precision with round-to-nearest, which is
+// monotonic: x <= y implies fl(x) <= fl(y). So for an op that is monotonic in each operand
+// and rounds once (add, sub, mul, min, max, sqrt, square, ...), computing the interval's
+// ends with the same float operation as the VM gives bounds that enclose the VM's results
+// exactly, with no outward rounding. Ops whose VM form may round more than once, or may be
+// contracted into an FMA by the compiler (MulAddI, Mix, Length2/3, Mod), and libm functions
+// (which may differ by an ulp between the scalar and a vectorised libm) are widened by a
+// few ulps. Min/max choices compare the interval ends with the same comparisons the VM's
+// om::min_ / om::max_ make, so a decided choice is the VM's choice at every point.
+#include "runtime/interval.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <new>
+
+// A new opcode must get its interval semantics here: a missing case is an error.
+#pragma GCC diagnostic error "-Wswitch"
+
+namespace sdfc {
+namespace {
+
+#if defined(__GNUC__)
+#define SDFC_IV_INLINE __attribute__((always_inline)) inline
+#else
+#define SDFC_IV_INLINE inline
+#endif
+
+#if defined(__clang__)
+#define SDFC_IVDEP _Pragma("clang loop vectorize(assume_safety)")
+#elif defined(__GNUC__)
+#define SDFC_IVDEP _Pragma("GCC ivdep")
+#else
+#define SDFC_IVDEP
+#endif
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kPi = 3.14159265358979f;
+
+// Outward widening by at least one ulp (two for normal numbers): dn(x) <= the float below x.
+SDFC_IV_INLINE float dn(float x) { return x - (std::fabs(x) * 0x1p-22f + 0x1p-126f); }
+SDFC_IV_INLINE float up(float x) { return x + (std::fabs(x) * 0x1p-22f + 0x1p-126f); }
+// Wider, for libm results (a few ulps between implementations).
+SDFC_IV_INLINE float dnw(float x) { return x - (std::fabs(x) * 0x1p-18f + 0x1p-120f); }
+SDFC_IV_INLINE float upw(float x) { return x + (std::fabs(x) * 0x1p-18f + 0x1p-120f); }
+
+SDFC_IV_INLINE float mn(float a, float b) { return b < a ? b : a; }
+SDFC_IV_INLINE float mx(float a, float b) { return a < b ? b : a; }
+
+// 0 for a finite value, NaN for an infinite or NaN one: added to both ends of a result, it
+// turns the result unknown when an operand may be infinite or NaN.
+SDFC_IV_INLINE float poison(float lo, float hi) { return (lo - lo) + (hi - hi); }
+
+// Interval product (corners); no NaN for finite operands.
+SDFC_IV_INLINE void mul_iv(float al, float ah, float bl, float bh, float& lo, float& hi) {
+    float p0 = al * bl, p1 = al * bh, p2 = ah * bl, p3 = ah * bh;
+    lo = mn(mn(p0, p1), mn(p2, p3));
+    hi = mx(mx(p0, p1), mx(p2, p3));
+}
+
+// Monotonic libm function, increasing.
+template <class F>
+SDFC_IV_INLINE void mono_inc(F f, float al, float ah, float& lo, float& hi) {
+    lo = dnw(f(al));
+    hi = upw(f(ah));
+}
+
+// sin over [l, h] (finite): the endpoints, plus +-1 when a peak may lie inside. `phase`
+// shifts the peaks: sin peaks at pi/2 + 2 pi n; cos = sin(x + pi/2) peaks at 2 pi n.
+SDFC_IV_INLINE void sin_iv(float l, float h, float peak_at, float (*f)(float), float& lo, float& hi) {
+    if (!(h - l < 6.0f) || std::fabs(l) > 1e5f || std::fabs(h) > 1e5f) {
+        lo = -1.0f;
+        hi = 1.0f;
+        return;
+    }
+    float fl = f(l), fh = f(h);
+    lo = dnw(mn(fl, fh));
+    hi = upw(mx(fl, fh));
+    // Peaks (value +1) at peak_at + 2 pi n, troughs at peak_at + pi + 2 pi n. Widen the
+    // search so that a peak just outside by rounding still counts.
+    const double tl = double(l) - 1e-3 - double(peak_at), th = double(h) + 1e-3 - double(peak_at);
+    const double two_pi = 6.283185307179586;
+    if (std::floor(th / two_pi) >= std::ceil(tl / two_pi)) hi = 1.0f;
+    if (std::floor((th - 3.141592653589793) / two_pi) >= std::ceil((tl - 3.141592653589793) / two_pi)) lo = -1.0f;
+    lo = mx(lo, -1.0f);
+    hi = mn(hi, 1.0f);
+}
+
+float sinf_(float x) { return std::sin(x); }
+float cosf_(float x) { return std::cos(x); }
+
+// The interval semantics of op O: [al, ah] etc. in, [lo, hi] and the choice out.
+template <Op O>
+SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float ch, float k, float& lo, float& hi,
+                       uint8_t& choice) {
+    choice = kChoiceBoth;
+    constexpr int arity = kOpInfo[int(O)].arity;
+    float z = arity >= 1 ? poison(al, ah) : 0.0f;
+    if constexpr (arity >= 2) z += poison(bl, bh);
+    if constexpr (arity >= 3) z += poison(cl, ch);
+    switch (O) {
+        case Op::Const: lo = hi = k; return;
+        case Op::VarX:
+        case Op::VarY:
+        case Op::VarZ:
+        case Op::Time:
+        case Op::Copy: lo = al; hi = ah; return;  // inputs are set by the evaluator
+        case Op::Neg: lo = -ah; hi = -al; return;
+        case Op::Abs:
+            lo = al >= 0.0f ? al : (ah <= 0.0f ? -ah : 0.0f);
+            hi = al >= 0.0f ? ah : (ah <= 0.0f ? -al : mx(-al, ah));
+            break;
+        case Op::Square: {
+            float l2 = al * al, h2 = ah * ah;
+            lo = al >= 0.0f ? l2 : (ah <= 0.0f ? h2 : 0.0f);
+            hi = al >= 0.0f ? h2 : (ah <= 0.0f ? l2 : mx(l2, h2));
+            break;
+        }
+        case Op::Sqrt:
+            lo = std::sqrt(mx(al, 0.0f));
+            hi = std::sqrt(mx(ah, 0.0f));
+            z += al < 0.0f ? kNaN : 0.0f;  // some point may take the root of a negative number
+            break;
+        case Op::Sin: sin_iv(al, ah, kPi / 2, sinf_, lo, hi); break;
+        case Op::Cos: sin_iv(al, ah, 0.0f, cosf_, lo, hi); break;
+        case Op::Tan: {
+            // Monotonic between asymptotes at pi/2 + pi n.
+            const double pi = 3.141592653589793;
+            bool ok = ah - al < 3.0f && std::fabs(al) < 1e5f && std::fabs(ah) < 1e5f &&
+                      std::floor((double(ah) + 1e-3 - pi / 2) / pi) < std::ceil((double(al) - 1e-3 - pi / 2) / pi);
+            lo = ok ? dnw(std::tan(al)) : -kInf;
+            hi = ok ? upw(std::tan(ah)) : kInf;
+            break;
+        }
+        case Op::Asin:
+            mono_inc([](float v) { return std::asin(om::clamp1(v)); }, al, ah, lo, hi);
+            break;
+        case Op::Acos:
+            lo = dnw(std::acos(om::clamp1(ah)));
+            hi = upw(std::acos(om::clamp1(al)));
+            break;
+        case Op::Atan: mono_inc([](float v) { return std::atan(v); }, al, ah, lo, hi); break;
+        case Op::Exp:
+            mono_inc([](float v) { return std::exp(v); }, al, ah, lo, hi);
+            lo = mx(lo, 0.0f);
+            break;
+        case Op::Log:
+            mono_inc([](float v) { return std::log(v); }, mx(al, 0.0f), mx(ah, 0.0f), lo, hi);
+            z = al < 0.0f ? kNaN : z;
+            break;
+        case Op::Floor: lo = std::floor(al); hi = std::floor(ah); break;
+        case Op::Ceil: lo = std::ceil(al); hi = std::ceil(ah); break;
+        case Op::Fract: {
+            float f = std::floor(al);
+            bool one_cell = f == std::floor(ah);
+            lo = one_cell ? al - f : 0.0f;
+            hi = one_cell ? ah - f : 1.0f;
+            break;
+        }
+        case Op::Sign: lo = om::sign(al); hi = om::sign(ah); break;
+        case Op::Not:
+            lo = ((al > 0.0f) | (ah < 0.0f)) ? 0.0f : (((al == 0.0f) & (ah == 0.0f)) ? 1.0f : 0.0f);
+            hi = ((al > 0.0f) | (ah < 0.0f)) ? 0.0f : 1.0f;
+            break;
+        case Op::Add: lo = al + bl; hi = ah + bh; break;
+        case Op::Sub: lo = al - bh; hi = ah - bl; break;
+        case Op::Mul: mul_iv(al, ah, bl, bh, lo, hi); break;
+        case Op::Div: {
+            float q0 = al / bl, q1 = al / bh, q2 = ah / bl, q3 = ah / bh;
+            lo = mn(mn(q0, q1), mn(q2, q3));
+            hi = mx(mx(q0, q1), mx(q2, q3));
+            z += ((bl > 0.0f) | (bh < 0.0f)) ? 0.0f : kNaN;  // the divisor may be zero
+            break;
+        }
+        case Op::Min:
+            // om::min_(a, b) = b < a ? b : a
+            lo = mn(al, bl);
+            hi = mn(ah, bh);
+            choice = uint8_t((ah <= bl) * kChoiceA + (bh < al) * kChoiceB);  // exclusive
+            break;
+        case Op::Max:
+            // om::max_(a, b) = a < b ? b : a
+            lo = mx(al, bl);
+            hi = mx(ah, bh);
+            choice = uint8_t((ah < bl) * kChoiceB + (bh <= al) * kChoiceA);
+            break;
+        case Op::Mod: {
+            // a - b floor(a / b) lies in [0, b) (b > 0) or (b, 0] (b < 0), up to rounding
+            // errors of about an ulp of a.
+            float m = mx(std::fabs(al), std::fabs(ah)) * 0x1p-20f + mx(std::fabs(bl), std::fabs(bh)) * 0x1p-20f + 0x1p-120f;
+            lo = bl > 0.0f ? -m : bl - m;
+            hi = bl > 0.0f ? bh + m : m;
+            // The quotient must not overflow (a - b*inf is infinite).
+            if (!((bl > 0.0f) | (bh < 0.0f)) || !(mx(std::fabs(al), std::fabs(ah)) < 1e30f * mn(std::fabs(bl), std::fabs(bh))))
+                z = kNaN;
+            break;
+        }
+        case Op::Pow: {
+            // For a > 0, pow is monotonic in each operand: the extremes are at corners.
+            float p0 = std::pow(al, bl), p1 = std::pow(al, bh), p2 = std::pow(ah, bl), p3 = std::pow(ah, bh);
+            lo = dnw(mn(mn(p0, p1), mn(p2, p3)));
+            hi = upw(mx(mx(p0, p1), mx(p2, p3)));
+            z = al > 0.0f ? z : kNaN;
+            break;
+        }
+        case Op::Atan2: lo = -3.1415930f; hi = 3.1415930f; break;
+        case Op::Lt:
+            lo = al >= bh ? 0.0f : (ah < bl ? 1.0f : 0.0f);
+            hi = al >= bh ? 0.0f : 1.0f;
+            break;
+        case Op::Le:
+            lo = al > bh ? 0.0f : (ah <= bl ? 1.0f : 0.0f);
+            hi = al > bh ? 0.0f : 1.0f;
+            break;
+        case Op::Eq: {
+            bool disjoint = (ah < bl) | (bh < al);
+            bool same = (al == ah) & (bl == bh) & (al == bl);
+            lo = same ? 1.0f : 0.0f;
+            hi = disjoint ? 0.0f : 1.0f;
+            break;
+        }
+        case Op::Ne: {
+            bool disjoint = (ah < bl) | (bh < al);
+            bool same = (al == ah) & (bl == bh) & (al == bl);
+            lo = disjoint ? 1.0f : 0.0f;
+            hi = same ? 0.0f : 1.0f;
+            break;
+        }
+        case Op::And:
+        case Op::Or: {
+            // Truth of an operand: known true when its interval excludes 0, known false when
+            // it is [0, 0].
+            bool at = (al > 0.0f) | (ah < 0.0f), af = (al == 0.0f) & (ah == 0.0f);
+            bool bt = (bl > 0.0f) | (bh < 0.0f), bf = (bl == 0.0f) & (bh == 0.0f);
+            bool t = O == Op::And ? (at & bt) : (at | bt);
+            bool f = O == Op::And ? (af | bf) : (af & bf);
+            lo = t ? 1.0f : 0.0f;
+            hi = f ? 0.0f : 1.0f;
+            break;
+        }
+        case Op::Length2: {
+            float a0 = al >= 0.0f ? al : (ah <= 0.0f ? -ah : 0.0f), a1 = mx(-al, ah);
+            float b0 = bl >= 0.0f ? bl : (bh <= 0.0f ? -bh : 0.0f), b1 = mx(-bl, bh);
+            lo = dn(std::sqrt(a0 * a0 + b0 * b0));
+            hi = up(std::sqrt(a1 * a1 + b1 * b1));
+            lo = mx(lo, 0.0f);
+            break;
+        }
+        case Op::Length3: {
+            float a0 = al >= 0.0f ? al : (ah <= 0.0f ? -ah : 0.0f), a1 = mx(-al, ah);
+            float b0 = bl >= 0.0f ? bl : (bh <= 0.0f ? -bh : 0.0f), b1 = mx(-bl, bh);
+            float c0 = cl >= 0.0f ? cl : (ch <= 0.0f ? -ch : 0.0f), c1 = mx(-cl, ch);
+            lo = dn(std::sqrt(a0 * a0 + b0 * b0 + c0 * c0));
+            hi = up(std::sqrt(a1 * a1 + b1 * b1 + c1 * c1));
+            lo = mx(lo, 0.0f);
+            break;
+        }
+        case Op::AddI: lo = al + k; hi = ah + k; break;
+        case Op::SubI: lo = k - ah; hi = k - al; break;
+        case Op::MulI: {
+            float p = al * k, q = ah * k;
+            lo = mn(p, q);
+            hi = mx(p, q);
+            z += k - k;
+            break;
+        }
+        case Op::DivI: {
+            float p = k / al, q = k / ah;
+            lo = mn(p, q);
+            hi = mx(p, q);
+            z += ((al > 0.0f) | (ah < 0.0f)) ? 0.0f : kNaN;
+            z += k - k;
+            break;
+        }
+        case Op::MinI:
+            // om::min_(a, k) = k < a ? k : a
+            lo = mn(al, k);
+            hi = mn(ah, k);
+            choice = uint8_t((ah <= k) * kChoiceA + (k < al) * kChoiceB);
+            break;
+        case Op::MaxI:
+            // om::max_(a, k) = a < k ? k : a
+            lo = mx(al, k);
+            hi = mx(ah, k);
+            choice = uint8_t((ah < k) * kChoiceB + (k <= al) * kChoiceA);
+            break;
+        case Op::ModI: {
+            float m = mx(std::fabs(al), std::fabs(ah)) * 0x1p-20f + std::fabs(k) * 0x1p-20f + 0x1p-120f;
+            // Within one period, a - k floor(a / k) is a - k f for one integer f: monotonic.
+            float fl = std::floor(al / k), fh = std::floor(ah / k);
+            bool one = (k > 0.0f) & (fl == fh);
+            float base = k * fl;
+            lo = one ? al - base - m : (k > 0.0f ? -m : k - m);
+            hi = one ? ah - base + m : (k > 0.0f ? k + m : m);
+            if (!(mx(std::fabs(al), std::fabs(ah)) < 1e30f * std::fabs(k))) z = kNaN;  // also k == 0
+            z += k - k;
+            break;
+        }
+        case Op::PowI: {
+            // Integer exponents: even like a square, odd monotonic; other exponents need a >= 0.
+            float pl = std::pow(al, k), ph = std::pow(ah, k);
+            bool integer = k == std::floor(k) && std::fabs(k) < 16777216.0f;
+            bool even = integer && std::fmod(k, 2.0f) == 0.0f;
+            bool spans0 = (al < 0.0f) & (ah > 0.0f);
+            if (k == 0.0f) {
+                lo = hi = 1.0f;
+            } else if (even && k > 0.0f) {
+                lo = al >= 0.0f ? pl : (ah <= 0.0f ? ph : 0.0f);
+                hi = al >= 0.0f ? ph : (ah <= 0.0f ? pl : mx(pl, ph));
+            } else {
+                lo = mn(pl, ph);
+                hi = mx(pl, ph);
+                bool monotonic = (integer && !(k < 0.0f && (spans0 || al == 0.0f || ah == 0.0f))) || al > 0.0f;
+                if (!monotonic) z = kNaN;
+            }
+            lo = dnw(lo);
+            hi = upw(hi);
+            z += k - k;
+            break;
+        }
+        case Op::MulAddI: {
+            float p = al * k, q = ah * k;
+            lo = dn(mn(p, q)) + bl;  // the VM may round a*k or fuse it into an FMA
+            hi = up(mx(p, q)) + bh;
+            z += k - k + poison(p, q);  // a*k may overflow, and inf - inf is NaN
+            break;
+        }
+        case Op::Select: {
+            // a != 0 ? b : c; a NaN counts as true, like in the VM. Only the side taken
+            // needs to be known.
+            const bool t = (al > 0.0f) | (ah < 0.0f), f = (al == 0.0f) & (ah == 0.0f);
+            const float zb = poison(bl, bh), zc = poison(cl, ch);
+            z = (t ? zb : 0.0f) + (f ? zc : 0.0f) + ((t | f) ? 0.0f : zb + zc);
+            lo = t ? bl : (f ? cl : mn(bl, cl));
+            hi = t ? bh : (f ? ch : mx(bh, ch));
+            choice = uint8_t(t * kChoiceB + f * kChoiceC);
+            break;
+        }
+        case Op::Mix: {
+            // b + (c - b) * a
+            float dl = cl - bh, dh = ch - bl, el, eh;
+            mul_iv(dl, dh, al, ah, el, eh);
+            z += poison(dl, dh);  // c - b may overflow, and inf * 0 is NaN
+            lo = dn(el) + bl;
+            hi = up(eh) + bh;
+            break;
+        }
+        case Op::Noise3: lo = -2.001f; hi = 2.001f; break;
+    }
+    lo += z;
+    hi += z;
+}
+
+void free_aligned(float* p) { std::free(p); }
+float* alloc_floats(size_t count) {  // uninitialised: a register is written before it is read
+    size_t bytes = (std::max<size_t>(count, 1) * sizeof(float) + 63) / 64 * 64;
+    void* p = std::aligned_alloc(64, bytes);
+    if (!p) throw std::bad_alloc();
+    return static_cast<float*>(p);
+}
+
+template <Op O>
+constexpr bool choice_op() {
+    return O == Op::Min || O == Op::Max || O == Op::MinI || O == Op::MaxI || O == Op::Select;
+}
+
+}  // namespace
+
+namespace {
+constexpr uint64_t kChoiceMask = 0
+#define OP(name, mn, ar, imm, sem, glsl) | (choice_op<Op::name>() ? uint64_t(1) << int(Op::name) : 0)
+#include "compiler/opcodes.def"
+#undef OP
+    ;
+static_assert(kOpCount <= 64);
+}  // namespace
+
+bool is_choice_op(Op op) { return (kChoiceMask >> int(op)) & 1; }
+
+Interval eval_interval(Op op, Interval a, Interval b, Interval c, float k, uint8_t* choice) {
+    Interval r{};
+    uint8_t ch = kChoiceBoth;
+    switch (op) {
+#define OP(name, mn, ar, imm, sem, glsl) \
+    case Op::name: iv<Op::name>(a.lo, a.hi, b.lo, b.hi, c.lo, c.hi, k, r.lo, r.hi, ch); break;
+#include "compiler/opcodes.def"
+#undef OP
+    }
+    if (choice) *choice = ch;
+    return r;
+}
+
+Tape Tape::from(const Program& p, int output) {
+    Tape t;
+    t.code = p.code;
+    t.out = p.outputs.at(static_cast<size_t>(output));
+    t.recount();
+    t.num_regs = std::max(t.num_regs, p.num_regs);
+    t.link();
+    return t;
+}
+
+void Tape::recount() {
+    uint32_t regs = uint32_t(out) + 1, ch = 0;
+    for (const Instr& in : code) {
+        regs = std::max<uint32_t>(regs, uint32_t(in.out) + 1);
+        ch += is_choice_op(in.op);
+    }
+    num_regs = regs;
+    choices = ch;
+}
+
+void Tape::link() {
+    const size_t n = code.size();
+    def.resize(n * 3);
+    slot.resize(n);
+    thread_local std::vector<uint32_t> last;
+    last.assign(std::max<uint32_t>(num_regs, uint32_t(out) + 1), kNone);
+    uint32_t sl = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const Instr& in = code[i];
+        const int ar = kOpInfo[int(in.op)].arity;
+        def[3 * i + 0] = ar > 0 ? last[in.a] : kNone;
+        def[3 * i + 1] = ar > 1 ? last[in.b] : kNone;
+        def[3 * i + 2] = ar > 2 ? last[in.c] : kNone;
+        slot[i] = is_choice_op(in.op) ? sl++ : kNone;
+        last[in.out] = uint32_t(i);
+    }
+    choices = sl;
+    out_def = last[out];
+    // A tape reading a register nobody wrote cannot be followed by def links.
+    linked = true;
+    for (size_t i = 0; i < n; ++i)
+        for (int j = 0; j < kOpInfo[int(code[i].op)].arity; ++j) linked &= def[3 * i + size_t(j)] != kNone;
+}
+
+IntervalEvaluator::IntervalEvaluator(uint32_t max_regs, uint32_t max_choices)
+    : max_regs_(std::max<uint32_t>(max_regs, 1)),
+      max_choices_(max_choices),
+      lo_store_(alloc_floats(size_t(max_regs_) * kIvLanes), &free_aligned),
+      hi_store_(alloc_floats(size_t(max_regs_) * kIvLanes), &free_aligned),
+      lo_(lo_store_.get()),
+      hi_(hi_store_.get()),
+      choices_(new uint8_t[std::max<size_t>(size_t(max_choices) * kIvLanes, 1)]) {}
+
+void IntervalEvaluator::eval(const Tape& t, const float* xlo, const float* xhi, const float* ylo, const float* yhi,
+                             const float* zlo, const float* zhi, int n, float time) {
+    const int m = (n + 7) / 8 * 8;  // lanes computed (whole vectors); padding copies lane n-1
+    stride_ = m;
+    out_ = t.out;
+    float* const L = lo_;
+    float* const H = hi_;
+    uint8_t* chp = choices_.get();
+    auto input = [&](const Instr& in, const float* l, const float* h) {
+        float* rl = L + size_t(in.out) * kIvLanes;
+        float* rh = H + size_t(in.out) * kIvLanes;
+        for (int i = 0; i < m; ++i) {
+            int j = i < n ? i : n - 1;
+            rl[i] = l[j];
+            rh[i] = h[j];
+        }
+    };
+    for (const Instr& in : t.code) {
+        float* rl = L + size_t(in.out) * kIvLanes;
+        float* rh = H + size_t(in.out) * kIvLanes;
+        const float* al = L + size_t(in.a) * kIvLanes;
+        const float* ah = H + size_t(in.a) * kIvLanes;
+        const float* bl = L + size_t(in.b) * kIvLanes;
+        const float* bh = H + size_t(in.b) * kIvLanes;
+        const float* cl = L + size_t(in.c) * kIvLanes;
+        const float* chh = H + size_t(in.c) * kIvLanes;
+        const float k = in.k;
+        switch (in.op) {
+#define OP(name, mn, ar, imm, sem, glsl)                                                    \
+    case Op::name:                                                                          \
+        if constexpr (Op::name == Op::VarX) input(in, xlo, xhi);                            \
+        else if constexpr (Op::name == Op::VarY) input(in, ylo, yhi);                       \
+        else if constexpr (Op::name == Op::VarZ) input(in, zlo, zhi);                       \
+        else if constexpr (Op::name == Op::Time) {                                          \
+            std::fill_n(rl, m, time);                                                       \
+            std::fill_n(rh, m, time);                                                       \
+        } else {                                                                            \
+            if constexpr (choice_op<Op::name>()) {                                          \
+                SDFC_IVDEP                                                                  \
+                for (int i = 0; i < m; ++i) {                                               \
+                    uint8_t c;                                                              \
+                    float lo, hi;                                                           \
+                    iv<Op::name>(al[i], ah[i], bl[i], bh[i], cl[i], chh[i], k, lo, hi, c);  \
+                    rl[i] = lo;                                                             \
+                    rh[i] = hi;                                                             \
+                    chp[i] = c;                                                             \
+                }                                                                           \
+                chp += m;                                                                   \
+            } else {                                                                        \
+                SDFC_IVDEP                                                                  \
+                for (int i = 0; i < m; ++i) {                                               \
+                    uint8_t c;                                                              \
+                    float lo, hi;                                                           \
+                    iv<Op::name>(al[i], ah[i], bl[i], bh[i], cl[i], chh[i], k, lo, hi, c);  \
+                    rl[i] = lo;                                                             \
+                    rh[i] = hi;                                                             \
+                }                                                                           \
+            }                                                                               \
+        }                                                                                   \
+        break;
+#include "compiler/opcodes.def"
+#undef OP
+        }
+    }
+}
+
+void simplify(const Tape& parent, const uint8_t* choices, int stride, int lane, Tape& out, SimplifyScratch& s) {
+    const size_t n = parent.code.size();
+    out.code.clear();
+    out.linked = false;
+    out.out = 0;
+    out.num_regs = 1;
+    out.choices = 0;
+    if (n == 0 || parent.out_def == Tape::kNone || !parent.linked) {
+        // The output is never written, or the tape reads unwritten registers: keep it as is.
+        out.code = parent.code;
+        out.out = parent.out;
+        out.num_regs = parent.num_regs;
+        out.choices = parent.choices;
+        return;
+    }
+    const size_t words = (n + 63) / 64;
+    s.live.assign(words, 0);
+    if (s.bind.size() < n) s.bind.resize(n);
+    if (s.free_regs.size() < n + 1) s.free_regs.resize(n + 1);
+    if (s.rev.size() < n + 1) s.rev.resize(n + 1);
+    Instr* rev = s.rev.data();
+    size_t nrev = 0;
+    uint16_t* free_regs = s.free_regs.data();
+    size_t nfree = 0;
+    uint16_t next = 0;
+    uint32_t nch = 0;
+    auto alloc = [&]() -> uint16_t { return nfree ? free_regs[--nfree] : next++; };
+    auto release = [&](uint16_t r) { free_regs[nfree++] = r; };
+    uint64_t* live = s.live.data();
+    uint16_t* bind = s.bind.data();
+    auto mark = [&](uint32_t d) { live[d >> 6] |= uint64_t(1) << (d & 63); };
+    auto is_live = [&](uint32_t d) { return (live[d >> 6] >> (d & 63)) & 1; };
+    mark(parent.out_def);
+    bind[parent.out_def] = alloc();
+    const uint8_t* cp = choices + lane;
+    const Instr* code = parent.code.data();
+    const uint32_t* defs = parent.def.data();
+    const uint32_t* slots = parent.slot.data();
+    for (size_t w = words; w-- > 0;) {
+        while (live[w]) {
+            const int b = 63 - __builtin_clzll(live[w]);
+            live[w] &= ~(uint64_t(1) << b);
+            const uint32_t i = uint32_t(w * 64 + size_t(b));
+            const Instr& in = code[i];
+            const uint16_t X = bind[i];
+            const uint32_t sl = slots[i];
+            const uint8_t ch = sl != Tape::kNone ? cp[size_t(sl) * size_t(stride)] : uint8_t(kChoiceBoth);
+            if (ch != kChoiceBoth) {
+                if ((in.op == Op::MinI || in.op == Op::MaxI) && ch == kChoiceB) {
+                    Instr c{Op::Const};
+                    c.out = X;
+                    c.k = in.k;
+                    rev[nrev++] = c;
+                    release(X);
+                    continue;
+                }
+                const uint32_t d = defs[3 * i + (ch == kChoiceA ? 0 : (ch == kChoiceB ? 1 : 2))];
+                if (!is_live(d)) {
+                    mark(d);
+                    bind[d] = X;  // the winner's value lives in X: no instruction
+                } else {
+                    Instr c{Op::Copy};
+                    c.out = X;
+                    c.a = bind[d];
+                    rev[nrev++] = c;
+                    release(X);
+                }
+                continue;
+            }
+            release(X);
+            Instr e = in;
+            e.out = X;
+            const int arity = kOpInfo[int(in.op)].arity;
+            uint16_t* ops[3] = {&e.a, &e.b, &e.c};
+            for (int j = 0; j < 3; ++j) {
+                if (j >= arity) {
+                    *ops[j] = 0;
+                    continue;
+                }
+                const uint32_t d = defs[3 * i + size_t(j)];
+                if (!is_live(d)) {
+                    mark(d);
+                    bind[d] = alloc();
+                }
+                *ops[j] = bind[d];
+            }
+            nch += (kChoiceMask >> int(in.op)) & 1;
+            rev[nrev++] = e;
+        }
+    }
+    out.code.resize(nrev);
+    for (size_t j = 0; j < nrev; ++j) out.code[j] = rev[nrev - 1 - j];
+    out.out = 0;  // the output was bound first
+    out.num_regs = std::max<uint32_t>(next, 1);
+    out.choices = nch;
+}
+
+}  // namespace sdfc

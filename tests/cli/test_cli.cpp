@@ -1,0 +1,118 @@
+// The sdfc command end to end (LANGUAGE.md section 10).
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+
+#include "run.hpp"
+#include "runtime/image.hpp"
+
+using namespace sdfc;
+using test::run_sdfc;
+namespace fs = std::filesystem;
+
+TEST_CASE("--help and --version") {
+    auto h = run_sdfc("--help");
+    CHECK(h.status == 0);
+    CHECK(h.out.find("sdfc render SCENE") != std::string::npos);
+    auto v = run_sdfc("--version");
+    CHECK(v.status == 0);
+    CHECK(v.out.rfind("sdfc ", 0) == 0);
+    auto rh = run_sdfc("render --help");
+    CHECK(rh.status == 0);
+    auto bad = run_sdfc("rendr x.sdf");
+    CHECK(bad.status == 1);
+    CHECK(bad.err == "sdfc: error: unknown command 'rendr' (did you mean `render`?)\n");
+}
+
+TEST_CASE("eval prints one distance per line") {
+    std::string s = test::write_temp("eval.sdf", "sphere(1);\ntranslate([3, 0, 0]) box(2);\n");
+    auto r = run_sdfc("eval '" + s + "' --at 0,0,0");
+    CHECK(r.status == 0);
+    CHECK(r.out == "-1\n");
+    std::string pts = test::write_temp("pts.txt", "2 0 0\n3 0 0\n0 0 0\n\n0 5 0\n");
+    auto r2 = run_sdfc("eval '" + s + "' --points '" + pts + "'");
+    CHECK(r2.status == 0);
+    CHECK(r2.out == "0\n-1\n-1\n4\n");
+    auto bad = run_sdfc("eval '" + s + "' --at 1,2");
+    CHECK(bad.status == 1);
+    CHECK(bad.err == "sdfc: error: --at takes 3 comma-separated numbers, not '1,2'\n");
+}
+
+TEST_CASE("check reports script errors with a caret and exit 1") {
+    std::string s = test::write_temp("bad.sdf", "sphere(1);\nbox(2, 3);\n");
+    auto r = run_sdfc("check '" + s + "'");
+    CHECK(r.status == 1);
+    CHECK(r.err == s + ":2:8: error: box takes at most 1 argument (size), but more were given\nbox(2, 3);\n       ^\n");
+    auto ok = run_sdfc("check '" + test::example("three-tori.sdf") + "'");
+    CHECK(ok.status == 0);
+    CHECK(ok.err.empty());
+    auto missing = run_sdfc("check /nonexistent/x.sdf");
+    CHECK(missing.status == 1);
+    CHECK(missing.err == "sdfc: error: cannot open '/nonexistent/x.sdf'\n");
+}
+
+TEST_CASE("render writes the image; an error leaves no file") {
+    std::string out = test::temp_dir() + "/tori.png";
+    fs::remove(out);
+    auto r = run_sdfc("render '" + test::example("three-tori.sdf") + "' -o '" + out + "' --width 160 --height 90 --samples 1 --quiet");
+    CHECK(r.status == 0);
+    REQUIRE(fs::exists(out));
+    Image img = read_image(out);
+    CHECK(img.width == 160);
+    CHECK(img.height == 90);
+    // Nothing but the image in the folder: no temp files left behind.
+    for (const auto& e : fs::directory_iterator(test::temp_dir()))
+        CHECK(e.path().filename().string().find(".tmp-") == std::string::npos);
+
+    std::string bad = test::write_temp("bad2.sdf", "sphere(;\n");
+    std::string out2 = test::temp_dir() + "/never.png";
+    auto e = run_sdfc("render '" + bad + "' -o '" + out2 + "'");
+    CHECK(e.status == 1);
+    CHECK(!fs::exists(out2));
+    CHECK(e.err.rfind(bad + ":1:8: error:", 0) == 0);
+}
+
+TEST_CASE("render --frames writes one file per frame, and they differ where the scene moves") {
+    std::string s = test::write_temp("anim.sdf",
+        "camera(position = [0, 0, 6]);\nrender(width = 64, height = 48);\ntranslate([sin(time * 3) * 1.5, 0, 0]) sphere(0.8);\n");
+    std::string pattern = test::temp_dir() + "/frame_{frame:04d}.png";
+    auto r = run_sdfc("render '" + s + "' -o '" + pattern + "' --frames 0:3 --fps 4 --quiet");
+    CHECK(r.status == 0);
+    std::vector<Image> frames;
+    for (int f = 0; f <= 3; ++f) {
+        std::string p = test::temp_dir() + "/frame_000" + std::to_string(f) + ".png";
+        REQUIRE(fs::exists(p));
+        frames.push_back(read_image(p));
+    }
+    CHECK(frames[0].pixels != frames[1].pixels);
+    CHECK(frames[1].pixels != frames[2].pixels);
+    auto bad = run_sdfc("render '" + s + "' -o '" + test::temp_dir() + "/x.png' --frames 0:3");
+    CHECK(bad.status == 1);
+    CHECK(bad.err == "sdfc: error: rendering several frames needs {frame:04d} in the output name\n");
+}
+
+TEST_CASE("compile --emit lists the AST, the IR and the bytecode") {
+    std::string s = test::write_temp("emit.sdf", "translate([1, 0, 0]) sphere(0.5);\n");
+    auto ast = run_sdfc("compile '" + s + "' --emit ast");
+    CHECK(ast.status == 0);
+    CHECK(ast.out.find("sphere") != std::string::npos);
+    auto ir = run_sdfc("compile '" + s + "' --emit ir");
+    CHECK(ir.status == 0);
+    CHECK(ir.out.find("length3") != std::string::npos);
+    auto bc = run_sdfc("compile '" + s + "' --emit bytecode");
+    CHECK(bc.status == 0);
+    CHECK(bc.out.find("; distance program") != std::string::npos);
+    CHECK(bc.out.find("add_i") != std::string::npos);
+    auto bad = run_sdfc("compile '" + s + "' --emit tokens");
+    CHECK(bad.status == 1);
+    CHECK(bad.err == "sdfc: error: --emit takes ast, ir or bytecode, not 'tokens'\n");
+}
+
+TEST_CASE("slice writes a cross-section picture") {
+    std::string out = test::temp_dir() + "/slice.png";
+    auto r = run_sdfc("slice '" + test::example("three-tori.sdf") + "' --axis z --at 0 -o '" + out + "' --width 200");
+    CHECK(r.status == 0);
+    REQUIRE(fs::exists(out));
+    Image img = read_image(out);
+    CHECK(img.width == 200);
+}

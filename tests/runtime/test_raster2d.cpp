@@ -1,0 +1,53 @@
+// The Prospero image (render_2d: quadtree + intervals + simplified tapes) is identical,
+// pixel for pixel, to brute-force evaluation of the same file.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+
+#include "compiler/compile.hpp"
+#include "lang/load.hpp"
+#include "runtime/slice.hpp"
+
+using namespace sdfc;
+namespace fs = std::filesystem;
+
+namespace {
+
+void check_identical(const std::string& name, int w, int h) {
+    const fs::path path = fs::path(SDFC_SHARED_DIR) / "bench" / "vm" / name;
+    if (!fs::exists(path)) {
+        WARN("skipped: " << path << " is absent");
+        return;
+    }
+    SourceManager sm;
+    Scene s = load_scene(sm, path.string());
+    CompiledScene cs = compile_scene(s);
+    REQUIRE(cs.is_2d);
+    RenderStats fast_stats, brute_stats;
+    Image fast = render_2d(cs, w, h, 0, false, &fast_stats);
+    Image brute = render_2d(cs, w, h, 0, true, &brute_stats);
+    REQUIRE(fast.width == w);
+    REQUIRE(fast.height == h);
+    REQUIRE(fast.pixels.size() == brute.pixels.size());
+    size_t differ = 0, white = 0;
+    for (size_t i = 0; i < fast.pixels.size(); ++i) {
+        differ += fast.pixels[i] != brute.pixels[i];
+        white += brute.pixels[i] > 0.5f;
+    }
+    INFO(name << " " << w << "x" << h << ": " << differ << " pixels differ, " << white << " white");
+    REQUIRE(differ == 0);
+    REQUIRE(white > 0);
+    REQUIRE(fast_stats.distance_points < brute_stats.distance_points);
+}
+
+}  // namespace
+
+TEST_CASE("render_2d: prospero.vm quadtree image equals brute force") { check_identical("prospero.vm", 1024, 1024); }
+
+TEST_CASE("render_2d: hi.vm and quarter.vm equal brute force, odd sizes too") {
+    check_identical("hi.vm", 1024, 1024);
+    check_identical("quarter.vm", 1024, 1024);
+    check_identical("hi.vm", 301, 173);
+    check_identical("quarter.vm", 77, 1000);
+    check_identical("prospero.vm", 517, 263);
+}
