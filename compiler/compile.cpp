@@ -10,10 +10,10 @@ namespace sdfc {
 LoweredScene lower_scene(Graph& g, const Scene& scene) {
     Vec3N p{g.input(Op::VarX), g.input(Op::VarY), g.input(Op::VarZ)};
     LoweredScene out;
-    out.distance = lower_distance(g, *scene.root, p);
+    // One pass gives both: the distance nodes are the same with or without materials.
     MaterialN base = default_material(g);
     Lowered l = lower_shape(g, *scene.root, p, &base);
-    out.shading_distance = l.lip == 1.0f ? l.d : g.mulc(l.d, 1.0f / l.lip);
+    out.distance = out.shading_distance = l.lip == 1.0f ? l.d : g.mulc(l.d, 1.0f / l.lip);
     out.material = l.m;
     return out;
 }

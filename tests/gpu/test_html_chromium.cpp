@@ -59,6 +59,7 @@ std::string chromium_command(const std::string& bin, const fs::path& profile, co
 }
 
 std::string pick_example() {
+    if (const char* e = std::getenv("SDFC_HTML_EXAMPLE"); e && *e) return e;  // another scene (development)
     const auto files = examples();
     for (const std::string& f : files)
         if (fs::path(f).filename() == "three-tori.sdf") return f;
