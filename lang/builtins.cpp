@@ -487,7 +487,8 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
     using B = Builtin;
     Graph& gr = *g;
     g->set_loc(m.loc);
-    const BoundArgs& a = *m.args.get();
+    static const BoundArgs kNoArgs;  // material()/color() modifiers carry none
+    const BoundArgs& a = m.args ? *m.args : kNoArgs;
     auto arg = [&](size_t i) -> const Value* { return a.get(i); };
     auto n0 = [&](size_t i, float def) { return arg(i) ? num(*arg(i), a.locs[i], "argument") : gr.constant(def); };
     auto v3 = [&](size_t i, float def) {
