@@ -49,8 +49,8 @@ usage:
 
 SCENE is a .sdf script or a .vm model (Prospero/Fidget flat SSA format).
 Safety limits (defaults in docs/language.md): --max-recursion N, --max-iterations N,
---max-shapes N, --max-ops N, --max-file-size BYTES, --max-pixels N (width*height*samples),
---max-frames N, --max-nesting N.
+--max-calls N, --max-shapes N, --max-shape-depth N, --max-ops N, --max-file-size BYTES,
+--max-pixels N (width*height*samples), --max-frames N, --max-nesting N.
 )";
 
 struct Common {
@@ -67,7 +67,9 @@ Common read_common(Args& a) {
         l.max_loop_iterations = Args::to_int("--max-iterations", *v, 1, 2000000000);
         l.max_total_iterations = std::max<long>(l.max_total_iterations, l.max_loop_iterations * 100L);
     }
+    if (auto v = a.value("--max-calls")) l.max_calls = size_t(Args::to_int("--max-calls", *v, 1, 2000000000));
     if (auto v = a.value("--max-shapes")) l.max_shapes = size_t(Args::to_int("--max-shapes", *v, 1, 2000000000));
+    if (auto v = a.value("--max-shape-depth")) l.max_shape_depth = Args::to_int("--max-shape-depth", *v, 1, 100000);
     if (auto v = a.value("--max-ops")) l.max_ops = size_t(Args::to_int("--max-ops", *v, 1, 2000000000));
     if (auto v = a.value("--max-file-size")) l.max_file_bytes = size_t(Args::to_int("--max-file-size", *v, 1, 2000000000));
     if (auto v = a.value("--max-nesting")) l.max_nesting = Args::to_int("--max-nesting", *v, 1, 100000);
@@ -319,6 +321,8 @@ int cmd_slice(Args& a) {
     }
     if (w) so.width = Args::to_int("--width", *w, 1, 16384);
     if (h) so.height = Args::to_int("--height", *h, 1, 16384);
+    if (double(so.width) * so.height > double(c.max_pixels))
+        throw UsageError(fmt::format("{}x{} pixels is over the limit of {} (raise it with --max-pixels)", so.width, so.height, c.max_pixels));
     SourceManager sm;
     CompiledScene cs = build(sm, path, c, time_s ? Args::to_float("--time", *time_s) : 0.0f);
     write_image(*out, render_slice(cs, so));

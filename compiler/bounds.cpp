@@ -26,6 +26,7 @@ bool is_empty(const Bounds& b) { return b.lo.x > b.hi.x || b.lo.y > b.hi.y || b.
 }  // namespace
 
 Bounds shape_bounds(const Graph& g, const Shape& s) {
+    check_stack(s.loc);
     // Every parameter must be a constant for a finite answer.
     std::vector<float> v;
     for (NodeId n : s.params) {

@@ -1,6 +1,8 @@
 // Scene -> CompiledScene: lower both roots, generate the two programs, resolve settings.
 #include "compiler/compile.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "compiler/lower.hpp"
@@ -23,10 +25,23 @@ namespace {
 float constant(const Graph& g, NodeId n, Loc loc, const char* what) {
     if (n == kNoNode) throw CompileError(loc, fmt::format("internal: {} is unset", what));
     if (!g.is_const(n)) throw CompileError(loc, fmt::format("{} must be a constant here", what));
+    if (!std::isfinite(g.const_value(n))) throw CompileError(loc, fmt::format("{} is not a finite number", what));
     return g.const_value(n);
 }
 glm::vec3 constant3(const Graph& g, const Vec3N& v, Loc loc, const char* what) {
     return {constant(g, v[0], loc, what), constant(g, v[1], loc, what), constant(g, v[2], loc, what)};
+}
+
+// Script constants are checked as the interpreter computes them, but lowering folds more
+// (a gyroid's 2*pi/period, a normal divided by its length...), which can still overflow:
+// a NaN or infinite constant in a program is an error at the line that made it.
+void check_constants(const Program& p) {
+    for (size_t i = 0; i < p.code.size(); ++i) {
+        const Instr& in = p.code[i];
+        if (op_info(in.op).has_imm && !std::isfinite(in.k))
+            throw CompileError(i < p.locs.size() ? p.locs[i] : Loc{},
+                               fmt::format("this expression is not a finite number ({})", in.k));
+    }
 }
 
 }  // namespace
@@ -41,6 +56,8 @@ CompiledScene compile_scene(const Scene& scene) {
                                    "emit_r", "emit_g", "emit_b"};
     for (NodeId m : ls.material) roots.push_back(m);
     cs.shading = codegen(g, roots, names);
+    check_constants(cs.distance);
+    check_constants(cs.shading);
 
     const CameraSettings& c = scene.camera;
     cs.camera.position = constant3(g, c.position, c.loc, "the camera position");
@@ -49,6 +66,12 @@ CompiledScene compile_scene(const Scene& scene) {
     cs.camera.fov = constant(g, c.fov, c.loc, "the camera fov");
     cs.camera.orthographic = c.orthographic;
     cs.camera.ortho_height = constant(g, c.ortho_height, c.loc, "the camera ortho_height");
+    // A view direction and a right vector must exist, or every ray is NaN.
+    const glm::vec3 view = cs.camera.target - cs.camera.position;
+    if (!(glm::length(view) > 0.0f))
+        throw CompileError(c.loc, "the camera's position and target are the same point");
+    if (!(glm::length(glm::cross(glm::normalize(view), glm::normalize(cs.camera.up))) > 1e-5f))
+        throw CompileError(c.loc, "the camera's up vector must not be zero or parallel to the view direction");
     for (const LightSettings& l : scene.lights) {
         ResolvedLight r;
         r.directional = l.directional;

@@ -139,6 +139,7 @@ NodeId lower_distance(Graph& g, const Shape& shape, const Vec3N& p) {
 }
 
 Lowered lower_shape(Graph& g, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    check_stack(s.loc);
     Loc saved = g.loc();
     if (s.loc.known()) g.set_loc(s.loc);
     L l{g};

@@ -2,7 +2,12 @@
 // grammar/; every node carries the Loc of its first character so diagnostics from any
 // later stage point at the script. Nodes are owned by their Module and never mutated
 // after parsing, so closures may keep raw pointers into the tree.
+//
+// Expr and Stmt nodes are allocated from a per-thread pool of same-size slots (a script is
+// mostly small nodes; see NodePool in lang/parser.cpp): new, delete and make_unique work as
+// usual, and a node may be deleted by any thread.
 #pragma once
+#include <cstddef>
 #include <memory>
 #include <optional>
 #include <string>
@@ -82,6 +87,9 @@ struct Expr {
     std::unique_ptr<Block> block;   // BlockExpr, For body (as block)
     std::vector<ForBinding> bindings;  // For
     ExprPtr body;                   // Field body, For body
+
+    static void* operator new(std::size_t size);
+    static void operator delete(void* p, std::size_t size) noexcept;
 };
 
 enum class StmtKind {
@@ -106,6 +114,9 @@ struct Stmt {
     StmtPtr then_branch, else_branch;  // If
     std::vector<ForBinding> bindings;  // For
     StmtPtr body;              // For
+
+    static void* operator new(std::size_t size);
+    static void operator delete(void* p, std::size_t size) noexcept;
 };
 
 struct Module {

@@ -274,7 +274,11 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
             locs.push_back(a.value->loc);
         }
         g->set_loc(loc);
-        return call_math(info, vals, locs, loc);
+        Value r = call_math(info, vals, locs, loc);
+        // Most results were checked component by component; this also covers the
+        // reductions (length, dot, distance, cross...), which can overflow too.
+        for (int i = 0; i < r.n; ++i) checked(r.c[i], loc);
+        return r;
     }
     Binder b{*this, info, {}};
     b.bind(args, env, loc);

@@ -2,6 +2,7 @@
 // expressions) and builtins.cpp (the built-in shapes, operations, settings and math).
 #pragma once
 #include <deque>
+#include <functional>
 #include <optional>
 #include <string_view>
 #include <unordered_map>
@@ -74,6 +75,9 @@ public:
     Value call_value(const Value& callee, const std::vector<ast::Arg>& args, Env* env, Loc loc);
     Value call_user(const Callable& fn, const std::vector<ast::Arg>& args, Env* env, Loc loc);
     Value apply(const ast::Expr& e, Env* env);
+    // Runs body once per combination of the bindings (the first varies slowest), each in a
+    // fresh scope; enforces the loop limits.
+    void run_for(const std::vector<ast::ForBinding>& bindings, Env* env, Loc loc, const std::function<void(Env*)>& body);
     ShapePtr to_shape(const Value& v, Loc loc, const char* what);
     ShapePtr union_of(std::vector<ShapePtr> shapes, Loc loc);
 
@@ -97,6 +101,7 @@ public:
     ShapePtr make_shape(Shape s);
     std::string describe(const Value& v);
     void check_limit_iterations(long n, Loc loc);
+    void count_calls(size_t n, Loc loc);  // function calls, field bodies, shapes applied to points
 
     SourceManager& sm;
     InterpretOptions opts;
@@ -107,9 +112,18 @@ public:
     std::deque<std::unique_ptr<Env>> envs;
     std::deque<std::unique_ptr<ast::Module>> modules;
     Env* new_env(Env* parent, bool field_scope = false);
+    // Scopes are freed when a loop iteration or a call ends (release_envs(size before it)),
+    // unless a closure (a def, a field, an import) may still reach them: pin_envs() keeps
+    // every scope that exists at that point.
+    size_t pinned_envs = 0;
+    void pin_envs() { pinned_envs = envs.size(); }
+    void release_envs(size_t mark) {
+        if (pinned_envs <= mark && envs.size() > mark) envs.resize(mark);
+    }
 
     int call_depth = 0;
     long total_iterations = 0;
+    size_t total_calls = 0;
     size_t shape_count = 0;
     std::vector<std::string> import_stack;          // canonical paths being imported
     std::unordered_map<std::string, Env*> imported; // canonical path -> its definitions

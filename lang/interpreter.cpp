@@ -93,10 +93,27 @@ void Interp::check_limit_iterations(long n, Loc loc) {
                               opts.limits.max_total_iterations));
 }
 
+void Interp::count_calls(size_t n, Loc loc) {
+    total_calls += n;
+    if (total_calls > opts.limits.max_calls)
+        fail(loc, fmt::format("the script made more than {} calls in all, counting field bodies and shapes applied "
+                              "to points (raise it with --max-calls)",
+                              opts.limits.max_calls));
+}
+
 ShapePtr Interp::make_shape(Shape s) {
     if (++shape_count > opts.limits.max_shapes)
         fail(s.loc, fmt::format("the scene has more than {} shapes (raise it with --max-shapes)", opts.limits.max_shapes));
-    for (const auto& c : s.children) s.depth = std::max(s.depth, c->depth + 1);
+    for (const auto& c : s.children) {
+        s.depth = std::max(s.depth, c->depth + 1);
+        s.tree_size += std::min(c->tree_size, opts.limits.max_shapes + 1);
+    }
+    // A shape used twice is lowered twice: count the tree as lowering walks it, so that
+    // sharing (`let b = union { a; a; }; let c = union { b; b; }; ...`) cannot blow up.
+    if (s.tree_size > opts.limits.max_shapes)
+        fail(s.loc, fmt::format("the scene has more than {} shapes, counting a shared shape at each use "
+                                "(raise it with --max-shapes)",
+                                opts.limits.max_shapes));
     if (s.depth > opts.limits.max_shape_depth)
         fail(s.loc, fmt::format("shapes nested more than {} deep (raise it with --max-shape-depth)", opts.limits.max_shape_depth));
     return std::make_shared<const Shape>(std::move(s));
@@ -176,6 +193,7 @@ struct IterItem {
 }  // namespace
 
 void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
+    check_stack(s.loc);
     g->set_loc(s.loc);
     switch (s.kind) {
         case ast::StmtKind::Empty:
@@ -184,7 +202,8 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
         case ast::StmtKind::Var: {
             if (s.kind == ast::StmtKind::Var && !env->field_scope)
                 fail(s.loc, "'var' is only allowed inside a field block; use 'let' for a constant");
-            if (find_builtin(s.name) || s.name == "time" || s.name == "pi" || s.name == "tau" || s.name == "e")
+            // Built-in functions keep their names; the constants (pi, tau, e, time) may be shadowed.
+            if (find_builtin(s.name))
                 fail(s.name_loc, fmt::format("'{}' is a built-in name and cannot be redefined", s.name));
             auto it = env->vars.find(s.name);
             if (it != env->vars.end())
@@ -213,6 +232,7 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             fn->name = s.name;
             fn->def = &s;
             fn->env = env;
+            pin_envs();
             Value v;
             v.t = VT::Function;
             v.fn = fn;
@@ -247,6 +267,7 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
                     if (st->kind == ast::StmtKind::Let || st->kind == ast::StmtKind::Import) exec(*st, defs, ignored);
                 import_stack.pop_back();
                 imported[key] = defs;
+                pin_envs();
             }
             for (const auto& [name, b] : defs->vars)
                 if (!env->vars.count(name)) env->vars[name] = b;
@@ -309,45 +330,49 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             }
             return;
         }
-        case ast::StmtKind::For: {
-            // Nested bindings: the first varies slowest.
-            long count = 0;
-            std::function<void(size_t, Env*)> loop = [&](size_t k, Env* outer) {
-                if (k == s.bindings.size()) {
-                    if (++count > opts.limits.max_loop_iterations)
-                        fail(s.loc, fmt::format("this loop runs more than {} iterations (raise it with --max-iterations)",
-                                                opts.limits.max_loop_iterations));
-                    check_limit_iterations(1, s.loc);
-                    Env* body = new_env(outer);
-                    exec(*s.body, body, out);
-                    return;
-                }
-                const ast::ForBinding& b = s.bindings[k];
-                Value it = eval(*b.iterable, outer);
-                auto bind = [&](Value v) {
-                    Env* e = new_env(outer);
-                    e->vars[b.name] = Binding{std::move(v), false, b.loc};
-                    loop(k + 1, e);
-                };
-                if (it.t == VT::Range) {
-                    const RangeVal& r = it.range;
-                    double n = std::floor((double(r.end) - r.start) / r.step + 1e-6) + 1;
-                    if (n > double(opts.limits.max_loop_iterations))
-                        fail(b.iterable->loc, fmt::format("this range has {} elements, over the loop limit of {} (raise it with --max-iterations)",
-                                                          n, opts.limits.max_loop_iterations));
-                    for (long i = 0; i < long(n); ++i) bind(Value::number(g->constant(float(r.start + double(r.step) * i))));
-                } else if (it.t == VT::Vector) {
-                    for (int i = 0; i < it.n; ++i) bind(Value::number(it.c[i]));
-                } else if (it.t == VT::List) {
-                    for (const Value& v : *it.list) bind(v);
-                } else {
-                    fail(b.iterable->loc, fmt::format("for iterates over a range or a vector, not {}", describe(it)));
-                }
-            };
-            loop(0, env);
+        case ast::StmtKind::For:
+            run_for(s.bindings, env, s.loc, [&](Env* body) { exec(*s.body, body, out); });
+            return;
+    }
+}
+
+void Interp::run_for(const std::vector<ast::ForBinding>& bindings, Env* env, Loc loc, const std::function<void(Env*)>& body) {
+    // Nested bindings: the first varies slowest.
+    long count = 0;
+    std::function<void(size_t, Env*)> loop = [&](size_t k, Env* outer) {
+        if (k == bindings.size()) {
+            if (++count > opts.limits.max_loop_iterations)
+                fail(loc, fmt::format("this loop runs more than {} iterations (raise it with --max-iterations)",
+                                      opts.limits.max_loop_iterations));
+            check_limit_iterations(1, loc);
+            body(new_env(outer));
             return;
         }
-    }
+        const ast::ForBinding& b = bindings[k];
+        Value it = eval(*b.iterable, outer);
+        auto bind = [&](Value v) {
+            const size_t mark = envs.size();
+            Env* e = new_env(outer);
+            e->vars[b.name] = Binding{std::move(v), false, b.loc};
+            loop(k + 1, e);
+            release_envs(mark);
+        };
+        if (it.t == VT::Range) {
+            const RangeVal& r = it.range;
+            double n = std::max(0.0, std::floor((double(r.end) - r.start) / r.step + 1e-6) + 1);
+            if (n > double(opts.limits.max_loop_iterations))
+                fail(b.iterable->loc, fmt::format("this range has {} elements, over the loop limit of {} (raise it with --max-iterations)",
+                                                  n, opts.limits.max_loop_iterations));
+            for (long i = 0; i < long(n); ++i) bind(Value::number(g->constant(float(r.start + double(r.step) * i))));
+        } else if (it.t == VT::Vector) {
+            for (int i = 0; i < it.n; ++i) bind(Value::number(it.c[i]));
+        } else if (it.t == VT::List) {
+            for (const Value& v : *it.list) bind(v);
+        } else {
+            fail(b.iterable->loc, fmt::format("for iterates over a range or a vector, not {}", describe(it)));
+        }
+    };
+    loop(0, env);
 }
 
 // ---------------------------------------------------------------- expressions
@@ -373,6 +398,7 @@ Value Interp::eval_block(const ast::Block& b, Env* env, bool field_scope) {
 
 Value Interp::eval(const ast::Expr& e, Env* env) {
     using K = ast::ExprKind;
+    check_stack(e.loc);
     g->set_loc(e.loc);
     switch (e.kind) {
         case K::Number: {
@@ -428,6 +454,11 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             }
             Value v;
             v.t = VT::List;
+            v.depth = 1;
+            for (const Value& it : items) v.depth = std::max(v.depth, it.depth + 1);
+            // Lists built by a loop (`l = [l];`) nest without nesting the syntax.
+            if (v.depth > uint32_t(opts.limits.max_nesting))
+                fail(e.loc, fmt::format("lists nested deeper than {} levels (raise it with --max-nesting)", opts.limits.max_nesting));
             v.list = std::make_shared<const std::vector<Value>>(std::move(items));
             return v;
         }
@@ -439,7 +470,7 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             v.range.step = 1.0f;
             if (e.elems[1]) {
                 v.range.step = const_num(eval(*e.elems[1], env), e.elems[1]->loc, "a range's step");
-                if (!(v.range.step > 0.0f)) fail(e.elems[1]->loc, "a range's step must be positive");
+                if (v.range.step == 0.0f || !std::isfinite(v.range.step)) fail(e.elems[1]->loc, "a range's step must not be zero");
             }
             if (!std::isfinite(v.range.start) || !std::isfinite(v.range.end)) fail(e.loc, "a range's ends must be finite");
             return v;
@@ -485,41 +516,10 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
         case K::For: {
             // for in modifier-target position: the union of the iterations.
             std::vector<ShapePtr> shapes;
-            long count = 0;
-            std::function<void(size_t, Env*)> loop = [&](size_t k, Env* outer) {
-                if (k == e.bindings.size()) {
-                    if (++count > opts.limits.max_loop_iterations)
-                        fail(e.loc, fmt::format("this loop runs more than {} iterations (raise it with --max-iterations)",
-                                                opts.limits.max_loop_iterations));
-                    check_limit_iterations(1, e.loc);
-                    Env* body = new_env(outer);
-                    Value v = e.block ? eval_block(*e.block, body, false) : eval(*e.body, body);
-                    shapes.push_back(to_shape(v, e.loc, "the body of a for"));
-                    return;
-                }
-                const ast::ForBinding& b = e.bindings[k];
-                Value it = eval(*b.iterable, outer);
-                auto bind = [&](Value v) {
-                    Env* en = new_env(outer);
-                    en->vars[b.name] = Binding{std::move(v), false, b.loc};
-                    loop(k + 1, en);
-                };
-                if (it.t == VT::Range) {
-                    const RangeVal& r = it.range;
-                    double n = std::floor((double(r.end) - r.start) / r.step + 1e-6) + 1;
-                    if (n > double(opts.limits.max_loop_iterations))
-                        fail(b.iterable->loc, fmt::format("this range has {} elements, over the loop limit of {} (raise it with --max-iterations)",
-                                                          n, opts.limits.max_loop_iterations));
-                    for (long i = 0; i < long(n); ++i) bind(Value::number(g->constant(float(r.start + double(r.step) * i))));
-                } else if (it.t == VT::Vector) {
-                    for (int i = 0; i < it.n; ++i) bind(Value::number(it.c[i]));
-                } else if (it.t == VT::List) {
-                    for (const Value& v : *it.list) bind(v);
-                } else {
-                    fail(b.iterable->loc, fmt::format("for iterates over a range or a vector, not {}", describe(it)));
-                }
-            };
-            loop(0, env);
+            run_for(e.bindings, env, e.loc, [&](Env* body) {
+                Value v = e.block ? eval_block(*e.block, body, false) : eval(*e.body, body);
+                shapes.push_back(to_shape(v, e.loc, "the body of a for"));
+            });
             return Value::of_shape(union_of(std::move(shapes), e.loc));
         }
         case K::Call: {
@@ -586,13 +586,20 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             const ast::Expr* body = e.body.get();
             std::string param = e.text;
             Loc ploc = e.loc;
+            pin_envs();  // the closure keeps env
             s.field = [this, env, body, param, ploc](Graph&, const Vec3N& p) -> NodeId {
-                if (++call_depth > opts.limits.max_recursion)
+                if (call_depth + 1 > opts.limits.max_recursion)
                     fail(ploc, fmt::format("recursion deeper than {} calls (raise it with --max-recursion)", opts.limits.max_recursion));
+                count_calls(1, ploc);
+                struct Depth {
+                    int& d;
+                    ~Depth() { --d; }
+                } depth{++call_depth};
+                const size_t mark = envs.size();
                 Env* fe = new_env(env, true);
                 fe->vars[param] = Binding{Value::vector(p.data(), 3), false, ploc};
                 Value v = eval(*body, fe);
-                --call_depth;
+                release_envs(mark);
                 if (v.t != VT::Number) fail(body->loc, fmt::format("a field must compute a number (the distance), not {}", describe(v)));
                 return v.c[0];
             };
@@ -612,6 +619,7 @@ Value Interp::call_value(const Value& callee, const std::vector<ast::Arg>& args,
         if (args.size() != 1 || !args[0].name.empty()) fail(loc, "a shape is applied to one point: s(p)");
         Value p = eval(*args[0].value, env);
         Vec3N pv = vec3(p, args[0].loc, "the point a shape is applied to", false);
+        count_calls(callee.shape->tree_size, loc);
         NodeId d = lower_distance(*g, *callee.shape, pv);
         return Value::number(d);
     }
@@ -650,25 +658,24 @@ Value Interp::call_user(const Callable& fn, const std::vector<ast::Arg>& args, E
     }
     if (call_depth + 1 > opts.limits.max_recursion)
         fail(loc, fmt::format("recursion deeper than {} calls in '{}' (raise it with --max-recursion)", opts.limits.max_recursion, fn.name));
-    ++call_depth;
+    count_calls(1, loc);
+    struct Depth {  // back out on any exit: the run goes on with the next statement after an error
+        int& d;
+        ~Depth() { --d; }
+    } depth{++call_depth};
+    const size_t mark = envs.size();
     Env* callenv = new_env(fn.env);
     callenv->field_scope = env->field_scope;
     for (size_t i = 0; i < def.params.size(); ++i) {
         const ast::Param& p = def.params[i];
         if (!given[i]) {
-            if (!p.default_value) { --call_depth; fail(loc, fmt::format("missing argument '{}' of {}", p.name, fn.name)); }
+            if (!p.default_value) fail(loc, fmt::format("missing argument '{}' of {}", p.name, fn.name));
             values[i] = eval(*p.default_value, callenv);
         }
         callenv->vars[p.name] = Binding{values[i], false, p.loc};
     }
-    Value r;
-    try {
-        r = eval(*def.value, callenv);
-    } catch (...) {
-        --call_depth;
-        throw;
-    }
-    --call_depth;
+    Value r = eval(*def.value, callenv);
+    release_envs(mark);
     return r;
 }
 

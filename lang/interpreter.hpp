@@ -12,9 +12,10 @@ namespace sdfc {
 
 struct Limits {
     int max_recursion = 64;               // nested def calls
+    size_t max_calls = 10000000;          // calls, field bodies and shapes applied to points, all together
     long max_loop_iterations = 100000;    // per for statement
     long max_total_iterations = 10000000; // all loops of a run together
-    size_t max_shapes = 1000000;          // shape nodes built
+    size_t max_shapes = 1000000;          // shapes built, and shapes in the scene tree (a shared one counts at each use)
     size_t max_ops = 20000000;            // IR nodes
     int max_nesting = 256;                // syntax nesting (parser)
     int max_shape_depth = 4000;           // depth of the shape tree

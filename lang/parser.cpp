@@ -4,18 +4,28 @@
 // a value stack (State::items) into one item (an expression, a statement, an argument...).
 // The control (base_control below) gives each such rule a frame, the stack size when the
 // rule started, so an action knows which items are its own; postfix actions (call, index,
-// swizzle, ternary tail, modifier target) also take the one item just below their frame, the
-// expression they extend. The control also
+// swizzle, ternary tail, operator chains, modifier target) also take the one item just below
+// their frame, the expression they extend. The control also
 //   - truncates the stack when a rule fails, so a backtracking alternative leaves nothing,
 //   - forces rewinding for error-point rules so errors point where the rule started,
 //   - counts nesting (rules deriving from grammar::nesting) against the depth limit,
 // and raises the messages of grammar/error_messages.hpp through tao::pegtl::must_if.
+//
+// Speed (see also the top of sdf_grammar.hpp): items are plain values (owning raw node
+// pointers, names as views of the source), an action works on its items in place, the input
+// tracks no line numbers (State::loc_at finds them in SourceFile::line_starts), and a
+// frame is a local of the control's match, not a stack of its own.
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <new>
+#include <memory>
 #include <string_view>
+#include <type_traits>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -34,48 +44,126 @@ namespace g = sdfc::grammar;
 enum class Tag : uint8_t { Expr, Stmt, Arg, Param, Binding, Name, Op, RangeMark, ResultMark };
 
 // Arg, Param and Binding items keep their parts in `name` and `expr` (the value, the
-// default, the iterable) until their parent node takes them.
+// default, the iterable) until their parent node takes them. An item owns its `expr` and
+// `stmt` (the State deletes what is left on the stack when parsing stops early); whoever
+// takes them from an item takes ownership through own()/own_stmt(), which clear the item.
 struct Item {
     Tag tag = Tag::Expr;
     BinOp op = BinOp::Add;
-    uint32_t height = 1; // height of the subtree
-    Loc loc;             // first character (for an Expr: including enclosing parentheses)
-    ExprPtr expr;
-    StmtPtr stmt;
-    std::string name;
+    uint32_t height = 1;    // height of the subtree
+    Loc loc;                // first character (for an Expr: including enclosing parentheses)
+    Expr* expr = nullptr;
+    Stmt* stmt = nullptr;
+    std::string_view name;  // a view of the source text
+};
+
+static_assert(std::is_trivially_copyable_v<Item> && std::is_trivially_destructible_v<Item>);
+
+ExprPtr own(Item& it) { return ExprPtr(std::exchange(it.expr, nullptr)); }
+StmtPtr own_stmt(Item& it) { return StmtPtr(std::exchange(it.stmt, nullptr)); }
+
+// The items of the current rule (pushed since it started), in place on the stack.
+struct Frame {
+    Item* items;
+    size_t size;
+    Item& operator[](size_t i) const { return items[i]; }
+    Item& front() const { return items[0]; }
+    Item& back() const { return items[size - 1]; }
+    Item* begin() const { return items; }
+    Item* end() const { return items + size; }
+};
+
+// The value stack: a growable array of plain items (pushing and dropping are a store and a
+// counter; dropping deletes nothing, see State::truncate).
+class ItemStack {
+    std::unique_ptr<Item[]> data_;
+    size_t size_ = 0, cap_ = 0;
+
+    void grow() {
+        size_t cap = cap_ ? 2 * cap_ : 256;
+        std::unique_ptr<Item[]> d(new Item[cap]);
+        std::copy(data_.get(), data_.get() + size_, d.get());
+        data_ = std::move(d);
+        cap_ = cap;
+    }
+
+public:
+    size_t size() const { return size_; }
+    Item* data() { return data_.get(); }
+    Item* begin() { return data_.get(); }
+    Item* end() { return data_.get() + size_; }
+    Item& operator[](size_t i) { return data_[i]; }
+    Item& back() { return data_[size_ - 1]; }
+    Item& emplace_back() {
+        if (size_ == cap_) grow();
+        Item& it = data_[size_++];
+        it = Item{};
+        return it;
+    }
+    void push_back(const Item& it) { emplace_back() = it; }
+    void pop_back() { --size_; }
+    void resize_down(size_t n) { size_ = n; }
 };
 
 struct State {
     const SourceFile* file = nullptr;
     unsigned max_depth = 256;
     unsigned max_height = 1024;
-    std::vector<Item> items;
-    std::vector<size_t> frames;
-    std::vector<Item> taken;  // reused by take()
+    ItemStack items;
+    size_t frame = 0;  // the current rule's frame: the stack size when it started
     unsigned depth = 0;
     const char* block_end = nullptr;  // where the last block's `}` (and the space after it) ended
 
+    // Lines are counted here, not by PEGTL (the input tracks no positions): `line` caches
+    // the line of the last lookup, and lookups mostly move forward a little.
+    const char* text = nullptr;
+    const size_t* line_starts = nullptr;
+    size_t line_count = 0;
+    size_t line = 0;  // 0-based index into line_starts
+
+    State() = default;
+    State(const State&) = delete;
+    State& operator=(const State&) = delete;
+    ~State() { truncate(0); }
+
     bool just_after_block(const char* current) const { return current == block_end; }
 
-    Loc loc(const pegtl::position& p) const {
-        return Loc{file, static_cast<uint32_t>(p.line), static_cast<uint32_t>(p.column)};
+    Loc loc_at(const char* p) {
+        const size_t off = static_cast<size_t>(p - text);
+        if (off < line_starts[line]) {
+            line = static_cast<size_t>(std::upper_bound(line_starts, line_starts + line, off) - line_starts) - 1;
+        } else {
+            while (line + 1 < line_count && line_starts[line + 1] <= off) {
+                if (line + 8 < line_count && line_starts[line + 8] <= off) {
+                    line = static_cast<size_t>(std::upper_bound(line_starts + line + 8, line_starts + line_count, off) -
+                                               line_starts) - 1;
+                    break;
+                }
+                ++line;
+            }
+        }
+        return Loc{file, static_cast<uint32_t>(line + 1), static_cast<uint32_t>(off - line_starts[line] + 1)};
     }
 
-    // The items of the current rule (pushed since it started), removed from the stack.
-    // Valid until the next take(); an action takes once.
-    std::vector<Item>& take() {
-        size_t f = frames.back();
-        taken.clear();
-        taken.insert(taken.end(), std::make_move_iterator(items.begin() + static_cast<ptrdiff_t>(f)),
-                     std::make_move_iterator(items.end()));
-        items.resize(f);
-        return taken;
+    // Drops the items above `n`, deleting the nodes they still own.
+    void truncate(size_t n) {
+        for (size_t i = n; i < items.size(); ++i) {
+            delete items[i].expr;
+            delete items[i].stmt;
+        }
+        items.resize_down(n);
     }
-    // The item just below the current rule's frame (what a postfix rule extends), removed.
-    Item take_below() {
-        Item it = std::move(items.back());
-        items.pop_back();
-        return it;
+
+    // The current rule's items; the action takes what it needs, then calls pop_frame().
+    Frame take() { return Frame{items.data() + frame, items.size() - frame}; }
+    void pop_frame() { truncate(frame); }
+    // The item just below the current rule's frame (what a postfix rule extends), removed
+    // from the stack; its expression is owned at once.
+    ExprPtr take_below(Item& it) {
+        Item& below = items[frame - 1];
+        it = below;
+        below.expr = nullptr;
+        return own(it);
     }
 
     void check_height(uint32_t height, Loc loc) const {
@@ -86,45 +174,38 @@ struct State {
     }
     void push_expr(ExprPtr e, Loc start, uint32_t height) {
         check_height(height, start);
-        Item it;
-        it.tag = Tag::Expr;
+        Item& it = items.emplace_back();
         it.loc = start;
         it.height = height;
-        it.expr = std::move(e);
-        items.push_back(std::move(it));
+        it.expr = e.release();
     }
     void push_stmt(StmtPtr s, uint32_t height) {
         if (height > max_height)
             throw CompileError(s->loc, fmt::format("statement nested deeper than {} levels", max_height));
-        Item it;
+        Item& it = items.emplace_back();
         it.tag = Tag::Stmt;
         it.loc = s->loc;
         it.height = height;
-        it.stmt = std::move(s);
-        items.push_back(std::move(it));
+        it.stmt = s.release();
     }
-    void push_mark(Tag t) {
-        Item it;
-        it.tag = t;
-        items.push_back(std::move(it));
-    }
+    void push_mark(Tag t) { items.emplace_back().tag = t; }
 };
 
 ExprPtr make(ExprKind k, Loc loc) {
-    auto e = std::make_unique<Expr>();
+    ExprPtr e(new Expr);
     e->kind = k;
     e->loc = loc;
     return e;
 }
 
 StmtPtr make_stmt(StmtKind k, Loc loc) {
-    auto s = std::make_unique<Stmt>();
+    StmtPtr s(new Stmt);
     s->kind = k;
     s->loc = loc;
     return s;
 }
 
-uint32_t max_height(const std::vector<Item>& items) {
+uint32_t max_height(const Frame& items) {
     uint32_t h = 0;
     for (const auto& it : items) h = std::max(h, it.height);
     return h;
@@ -135,16 +216,43 @@ uint32_t max_height(const std::vector<Item>& items) {
 template <typename Rule>
 struct action : pegtl::nothing<Rule> {};
 
+// Digits with an optional '.' and fraction, at most 15 digits in all: the value is exact
+// as an integer and a power of ten, so one division rounds it exactly as from_chars would.
+bool simple_number(std::string_view s, double& v) {
+    if (s.size() > 16) return false;
+    uint64_t m = 0;
+    int digits = 0, frac = -1;
+    for (char c : s) {
+        if (c >= '0' && c <= '9') {
+            m = m * 10 + static_cast<uint64_t>(c - '0');
+            ++digits;
+            if (frac >= 0) ++frac;
+        } else if (c == '.' && frac < 0) {
+            frac = 0;
+        } else {
+            return false;  // an exponent
+        }
+    }
+    if (digits == 0 || digits > 15) return false;
+    static constexpr double pow10[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
+    v = static_cast<double>(m);
+    if (frac > 0) v /= pow10[frac];
+    return true;
+}
+
 template <>
 struct action<g::number_lit> {
     template <typename In>
     static void apply(const In& in, State& st) {
         double v = 0;
-        auto [ptr, ec] = std::from_chars(in.begin(), in.end(), v);
-        Loc loc = st.loc(in.position());
-        if (ec == std::errc::result_out_of_range || !std::isfinite(v))
-            throw CompileError(loc, fmt::format("number '{}' is out of range", in.string_view()));
-        if (ec != std::errc() || ptr != in.end()) throw CompileError(loc, fmt::format("invalid number '{}'", in.string_view()));
+        Loc loc = st.loc_at(in.begin());
+        if (!simple_number(in.string_view(), v)) {
+            auto [ptr, ec] = std::from_chars(in.begin(), in.end(), v);
+            if (ec == std::errc::result_out_of_range || !std::isfinite(v))
+                throw CompileError(loc, fmt::format("number '{}' is out of range", in.string_view()));
+            if (ec != std::errc() || ptr != in.end())
+                throw CompileError(loc, fmt::format("invalid number '{}'", in.string_view()));
+        }
         auto e = make(ExprKind::Number, loc);
         e->number = v;
         st.push_expr(std::move(e), loc, 1);
@@ -167,7 +275,7 @@ struct action<g::string_text> {
             char c = raw[++i];  // the grammar guarantees a valid escape
             text += c == 'n' ? '\n' : c == 't' ? '\t' : c;
         }
-        Loc loc = st.loc(in.position());
+        Loc loc = st.loc_at(in.begin());
         auto e = make(ExprKind::String, loc);
         e->text = std::move(text);
         st.push_expr(std::move(e), loc, 1);
@@ -178,7 +286,7 @@ template <bool Value>
 struct bool_action {
     template <typename In>
     static void apply(const In& in, State& st) {
-        Loc loc = st.loc(in.position());
+        Loc loc = st.loc_at(in.begin());
         auto e = make(ExprKind::Bool, loc);
         e->boolean = Value;
         st.push_expr(std::move(e), loc, 1);
@@ -191,9 +299,9 @@ template <>
 struct action<g::ident_name> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        Loc loc = st.loc(in.position());
+        Loc loc = st.loc_at(in.begin());
         auto e = make(ExprKind::Ident, loc);
-        e->text = in.string();
+        e->text = in.string_view();
         st.push_expr(std::move(e), loc, 1);
     }
 };
@@ -202,11 +310,10 @@ struct action<g::ident_name> {
 struct name_action {
     template <typename In>
     static void apply(const In& in, State& st) {
-        Item it;
+        Item& it = st.items.emplace_back();
         it.tag = Tag::Name;
-        it.loc = st.loc(in.position());
-        it.name = in.string();
-        st.items.push_back(std::move(it));
+        it.loc = st.loc_at(in.begin());
+        it.name = in.string_view();
     }
 };
 template <> struct action<g::arg_name> : name_action {};
@@ -219,11 +326,10 @@ template <BinOp Op>
 struct op_action {
     template <typename In>
     static void apply(const In& in, State& st) {
-        Item it;
+        Item& it = st.items.emplace_back();
         it.tag = Tag::Op;
-        it.loc = st.loc(in.position());
+        it.loc = st.loc_at(in.begin());
         it.op = Op;
-        st.items.push_back(std::move(it));
     }
 };
 template <> struct action<g::op_or> : op_action<BinOp::Or> {};
@@ -240,43 +346,47 @@ template <> struct action<g::op_mul> : op_action<BinOp::Mul> {};
 template <> struct action<g::op_div> : op_action<BinOp::Div> {};
 template <> struct action<g::op_mod> : op_action<BinOp::Mod> {};
 
-// `a op b op c` -> ((a op b) op c). A Binary node's loc is its operator (where errors such
+// `a op b op c` -> ((a op b) op c): a chain [op, b, op, c...] folded onto its left operand,
+// once the whole chain has been read. A Binary node's loc is its operator (where errors such
 // as "division by zero" belong); the item keeps the first character for enclosing nodes.
 struct fold_action {
     template <typename In>
     static void apply(const In&, State& st) {
-        if (st.items.size() - st.frames.back() == 1) return;
-        auto& items = st.take();
-        Item acc = std::move(items[0]);
-        for (size_t i = 1; i + 1 < items.size(); i += 2) {
+        Item acc;
+        ExprPtr lhs = st.take_below(acc);
+        Frame items = st.take();
+        for (size_t i = 0; i + 1 < items.size; i += 2) {
             Item& rhs = items[i + 1];
             auto e = make(ExprKind::Binary, items[i].loc);
             e->bin_op = items[i].op;
-            e->lhs = std::move(acc.expr);
-            e->rhs = std::move(rhs.expr);
+            e->lhs = std::move(lhs);
+            e->rhs = own(rhs);
             acc.height = 1 + std::max(acc.height, rhs.height);
-            acc.expr = std::move(e);
+            lhs = std::move(e);
             st.check_height(acc.height, acc.loc);
         }
-        st.push_expr(std::move(acc.expr), acc.loc, acc.height);
+        st.truncate(st.frame - 1);  // the chain and the left operand below it, all taken
+        st.push_expr(std::move(lhs), acc.loc, acc.height);
     }
 };
-template <> struct action<g::mul_level> : fold_action {};
-template <> struct action<g::add_level> : fold_action {};
-template <> struct action<g::cmp_level> : fold_action {};
-template <> struct action<g::and_level> : fold_action {};
-template <> struct action<g::or_level> : fold_action {};
+template <> struct action<g::mul_chain> : fold_action {};
+template <> struct action<g::add_chain> : fold_action {};
+template <> struct action<g::cmp_chain> : fold_action {};
+template <> struct action<g::and_chain> : fold_action {};
+template <> struct action<g::or_chain> : fold_action {};
 
 template <UnOp Op>
 struct unary_action {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto& items = st.take();
-        Loc loc = st.loc(in.position());
+        Frame items = st.take();
+        Loc loc = st.loc_at(in.begin());
         auto e = make(ExprKind::Unary, loc);
         e->un_op = Op;
-        e->lhs = std::move(items[0].expr);
-        st.push_expr(std::move(e), loc, items[0].height + 1);
+        e->lhs = own(items[0]);
+        uint32_t h = items[0].height + 1;
+        st.pop_frame();
+        st.push_expr(std::move(e), loc, h);
     }
 };
 template <> struct action<g::neg_expr> : unary_action<UnOp::Neg> {};
@@ -286,13 +396,17 @@ template <>
 struct action<g::ternary_tail> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto& items = st.take();
-        Item cond = st.take_below();
+        Item cond;
+        ExprPtr c = st.take_below(cond);
+        Frame items = st.take();
         auto e = make(ExprKind::Ternary, cond.loc);
         uint32_t h = 1 + std::max(cond.height, max_height(items));
-        e->elems.push_back(std::move(cond.expr));
-        e->elems.push_back(std::move(items[0].expr));
-        e->elems.push_back(std::move(items[1].expr));
+        e->elems.reserve(3);
+        e->elems.push_back(std::move(c));
+        e->elems.push_back(own(items[0]));
+        e->elems.push_back(own(items[1]));
+        st.pop_frame();
+        st.items.pop_back();  // cond
         st.push_expr(std::move(e), cond.loc, h);
     }
 };
@@ -302,7 +416,7 @@ template <>
 struct action<g::paren_expr> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        st.items.back().loc = st.loc(in.position());
+        st.items.back().loc = st.loc_at(in.begin());
     }
 };
 
@@ -310,20 +424,22 @@ template <>
 struct action<g::arg> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto& items = st.take();
+        Frame items = st.take();
         Item it;
         it.tag = Tag::Arg;
         it.loc = items[0].loc;  // the name, or the value of a positional argument
-        if (items.size() == 2) it.name = std::move(items[0].name);
+        if (items.size == 2) it.name = items[0].name;
         it.height = items.back().height;
-        it.expr = std::move(items.back().expr);
-        st.items.push_back(std::move(it));
+        it.expr = std::exchange(items.back().expr, nullptr);
+        st.pop_frame();
+        st.items.push_back(it);
     }
 };
 
-std::vector<Arg> take_args(std::vector<Item>& items, size_t begin, size_t end) {
+std::vector<Arg> take_args(const Frame& items, size_t begin, size_t end) {
     std::vector<Arg> args;
-    for (size_t i = begin; i < end; ++i) args.push_back(Arg{items[i].loc, std::move(items[i].name), std::move(items[i].expr)});
+    args.reserve(end - begin);
+    for (size_t i = begin; i < end; ++i) args.push_back(Arg{items[i].loc, std::string(items[i].name), own(items[i])});
     return args;
 }
 
@@ -331,12 +447,15 @@ template <>
 struct action<g::call_suffix> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto& items = st.take();
-        Item callee = st.take_below();
+        Item callee;
+        ExprPtr c = st.take_below(callee);
+        Frame items = st.take();
         auto e = make(ExprKind::Call, callee.loc);
         uint32_t h = 1 + std::max(callee.height, max_height(items));
-        e->callee = std::move(callee.expr);
-        e->args = take_args(items, 0, items.size());
+        e->callee = std::move(c);
+        e->args = take_args(items, 0, items.size);
+        st.pop_frame();
+        st.items.pop_back();  // the callee
         st.push_expr(std::move(e), callee.loc, h);
     }
 };
@@ -345,12 +464,15 @@ template <>
 struct action<g::index_suffix> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto& items = st.take();
-        Item lhs = st.take_below();
+        Item lhs;
+        ExprPtr l = st.take_below(lhs);
+        Frame items = st.take();
         auto e = make(ExprKind::Index, lhs.loc);
         uint32_t h = 1 + std::max(lhs.height, items[0].height);
-        e->lhs = std::move(lhs.expr);
-        e->rhs = std::move(items[0].expr);
+        e->lhs = std::move(l);
+        e->rhs = own(items[0]);
+        st.pop_frame();
+        st.items.pop_back();
         st.push_expr(std::move(e), lhs.loc, h);
     }
 };
@@ -362,10 +484,12 @@ struct action<g::swizzle_suffix> {
         std::string_view s = in.string_view().substr(1);  // after the '.'
         size_t n = 0;
         while (n < s.size() && (std::isalnum(static_cast<unsigned char>(s[n])) || s[n] == '_')) ++n;
-        Item lhs = st.take_below();
+        Item lhs;
+        ExprPtr l = st.take_below(lhs);
+        st.items.pop_back();
         auto e = make(ExprKind::Swizzle, lhs.loc);
-        e->text = std::string(s.substr(0, n));
-        e->lhs = std::move(lhs.expr);
+        e->text = s.substr(0, n);
+        e->lhs = std::move(l);
         st.push_expr(std::move(e), lhs.loc, lhs.height + 1);
     }
 };
@@ -382,19 +506,21 @@ template <>
 struct action<g::bracket_expr> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto& items = st.take();
-        Loc loc = st.loc(in.position());
-        bool range = !items.empty() && items.back().tag == Tag::RangeMark;
-        if (range) items.pop_back();
+        Frame items = st.take();
+        Loc loc = st.loc_at(in.begin());
+        bool range = items.size != 0 && items.back().tag == Tag::RangeMark;
+        if (range) --items.size;
         auto e = make(range ? ExprKind::Range : ExprKind::Vector, loc);
         uint32_t h = 1 + max_height(items);
+        e->elems.reserve(range ? 3 : items.size);
         if (range) {
-            e->elems.push_back(std::move(items.front().expr));
-            e->elems.push_back(items.size() == 3 ? std::move(items[1].expr) : nullptr);
-            e->elems.push_back(std::move(items.back().expr));
+            e->elems.push_back(own(items.front()));
+            e->elems.push_back(items.size == 3 ? own(items[1]) : nullptr);
+            e->elems.push_back(own(items.back()));
         } else {
-            for (auto& it : items) e->elems.push_back(std::move(it.expr));
+            for (auto& it : items) e->elems.push_back(own(it));
         }
+        st.pop_frame();
         st.push_expr(std::move(e), loc, h);
     }
 };
@@ -403,21 +529,23 @@ template <>
 struct action<g::binding> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto& items = st.take();
+        Frame items = st.take();
         Item it;
         it.tag = Tag::Binding;
         it.loc = items[0].loc;
         it.height = items[1].height;
-        it.name = std::move(items[0].name);
-        it.expr = std::move(items[1].expr);
-        st.items.push_back(std::move(it));
+        it.name = items[0].name;
+        it.expr = std::exchange(items[1].expr, nullptr);
+        st.pop_frame();
+        st.items.push_back(it);
     }
 };
 
-std::vector<ForBinding> take_bindings(std::vector<Item>& items) {
+std::vector<ForBinding> take_bindings(const Frame& items, size_t end) {
     std::vector<ForBinding> out;
-    for (auto& it : items)
-        if (it.tag == Tag::Binding) out.push_back(ForBinding{it.loc, std::move(it.name), std::move(it.expr)});
+    out.reserve(end);
+    for (size_t i = 0; i < end; ++i)
+        if (items[i].tag == Tag::Binding) out.push_back(ForBinding{items[i].loc, std::string(items[i].name), own(items[i])});
     return out;
 }
 
@@ -425,13 +553,13 @@ template <>
 struct action<g::for_expr> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto& items = st.take();
-        Loc loc = st.loc(in.position());
+        Frame items = st.take();
+        Loc loc = st.loc_at(in.begin());
         auto e = make(ExprKind::For, loc);
         uint32_t h = 1 + max_height(items);
-        e->body = std::move(items.back().expr);
-        items.pop_back();
-        e->bindings = take_bindings(items);
+        e->body = own(items.back());
+        e->bindings = take_bindings(items, items.size - 1);
+        st.pop_frame();
         st.push_expr(std::move(e), loc, h);
     }
 };
@@ -441,12 +569,14 @@ template <>
 struct action<g::if_expr> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto& items = st.take();
-        Loc loc = st.loc(in.position());
+        Frame items = st.take();
+        Loc loc = st.loc_at(in.begin());
         auto e = make(ExprKind::If, loc);
         uint32_t h = 1 + max_height(items);
-        for (auto& it : items) e->elems.push_back(std::move(it.expr));
+        e->elems.reserve(3);
+        for (auto& it : items) e->elems.push_back(own(it));
         if (e->elems.size() == 2) e->elems.push_back(nullptr);
+        st.pop_frame();
         st.push_expr(std::move(e), loc, h);
     }
 };
@@ -455,14 +585,15 @@ template <>
 struct action<g::field_expr> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto& items = st.take();
-        Loc loc = st.loc(in.position());
+        Frame items = st.take();
+        Loc loc = st.loc_at(in.begin());
         auto e = make(ExprKind::Field, loc);
         uint32_t h = 1 + max_height(items);
-        size_t n = items.size();
-        e->body = std::move(items[n - 1].expr);
-        e->text = std::move(items[n - 2].name);
+        size_t n = items.size;
+        e->body = own(items[n - 1]);
+        e->text = items[n - 2].name;
         e->args = take_args(items, 0, n - 2);
+        st.pop_frame();
         st.push_expr(std::move(e), loc, h);
     }
 };
@@ -479,18 +610,20 @@ template <>
 struct action<g::block> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto& items = st.take();
-        Loc loc = st.loc(in.position());
+        Frame items = st.take();
+        Loc loc = st.loc_at(in.begin());
         auto e = make(ExprKind::BlockExpr, loc);
         e->block = std::make_unique<Block>();
         e->block->loc = loc;
         uint32_t h = 2 + max_height(items);
+        e->block->stmts.reserve(items.size);
         for (auto& it : items) {
             if (it.tag == Tag::Stmt)
-                e->block->stmts.push_back(std::move(it.stmt));
+                e->block->stmts.push_back(own_stmt(it));
             else
-                e->block->result = std::move(it.expr);  // only ever the last item
+                e->block->result = own(it);  // only ever the last item
         }
+        st.pop_frame();
         st.push_expr(std::move(e), loc, h);
     }
 };
@@ -500,16 +633,18 @@ template <>
 struct action<g::apply_target> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto& items = st.take();
-        Item mod = st.take_below();
-        Item& target = items[0];
+        Item& target = st.take()[0];
+        Item& mod = st.items[st.frame - 1];
         if (mod.expr->kind != ExprKind::Call && mod.expr->kind != ExprKind::Ident)
             throw CompileError(target.loc, "only a call or a name can be applied to a shape (is a ';' missing?)");
-        auto e = make(ExprKind::Apply, mod.loc);
+        Loc mod_loc = mod.loc;
+        auto e = make(ExprKind::Apply, mod_loc);
         uint32_t h = 1 + std::max(mod.height, target.height);
-        e->lhs = std::move(mod.expr);
-        e->rhs = std::move(target.expr);
-        st.push_expr(std::move(e), mod.loc, h);
+        e->lhs = own(mod);
+        e->rhs = own(target);
+        st.pop_frame();
+        st.items.pop_back();  // the modifier
+        st.push_expr(std::move(e), mod_loc, h);
     }
 };
 
@@ -519,12 +654,14 @@ template <StmtKind Kind>
 struct binding_stmt_action {  // let / var / assign: [name, value]
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto& items = st.take();
-        auto s = make_stmt(Kind, st.loc(in.position()));
-        s->name = std::move(items[0].name);
+        Frame items = st.take();
+        auto s = make_stmt(Kind, st.loc_at(in.begin()));
+        s->name = items[0].name;
         s->name_loc = items[0].loc;
-        s->value = std::move(items[1].expr);
-        st.push_stmt(std::move(s), items[1].height + 1);
+        s->value = own(items[1]);
+        uint32_t h = items[1].height + 1;
+        st.pop_frame();
+        st.push_stmt(std::move(s), h);
     }
 };
 template <> struct action<g::let_stmt> : binding_stmt_action<StmtKind::Let> {};
@@ -534,14 +671,15 @@ template <> struct action<g::assign_stmt> : binding_stmt_action<StmtKind::Assign
 struct param_action {  // [name, default?]
     template <typename In>
     static void apply(const In&, State& st) {
-        auto& items = st.take();
+        Frame items = st.take();
         Item it;
         it.tag = Tag::Param;
         it.loc = items[0].loc;
         it.height = items.back().height;
-        it.name = std::move(items[0].name);
-        if (items.size() == 2) it.expr = std::move(items[1].expr);
-        st.items.push_back(std::move(it));
+        it.name = items[0].name;
+        if (items.size == 2) it.expr = std::exchange(items[1].expr, nullptr);
+        st.pop_frame();
+        st.items.push_back(it);
     }
 };
 template <> struct action<g::expect_param> : param_action {};
@@ -550,14 +688,17 @@ template <>
 struct action<g::def_stmt> {  // [name, params..., value]
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto& items = st.take();
-        auto s = make_stmt(StmtKind::Def, st.loc(in.position()));
-        s->name = std::move(items.front().name);
+        Frame items = st.take();
+        auto s = make_stmt(StmtKind::Def, st.loc_at(in.begin()));
+        s->name = items.front().name;
         s->name_loc = items.front().loc;
-        for (size_t i = 1; i + 1 < items.size(); ++i)
-            s->params.push_back(Param{items[i].loc, std::move(items[i].name), std::move(items[i].expr)});
-        s->value = std::move(items.back().expr);
-        st.push_stmt(std::move(s), 1 + max_height(items));
+        s->params.reserve(items.size - 2);
+        for (size_t i = 1; i + 1 < items.size; ++i)
+            s->params.push_back(Param{items[i].loc, std::string(items[i].name), own(items[i])});
+        s->value = own(items.back());
+        uint32_t h = 1 + max_height(items);
+        st.pop_frame();
+        st.push_stmt(std::move(s), h);
     }
 };
 
@@ -565,10 +706,12 @@ template <>
 struct action<g::import_stmt> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto& items = st.take();
-        auto s = make_stmt(StmtKind::Import, st.loc(in.position()));
-        s->name = std::move(items[0].expr->text);
+        Frame items = st.take();
+        auto s = make_stmt(StmtKind::Import, st.loc_at(in.begin()));
+        ExprPtr path = own(items[0]);
+        s->name = std::move(path->text);
         s->name_loc = items[0].loc;
+        st.pop_frame();
         st.push_stmt(std::move(s), 1);
     }
 };
@@ -577,12 +720,14 @@ template <>
 struct action<g::if_stmt> {  // [cond, then, else?]
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto& items = st.take();
-        auto s = make_stmt(StmtKind::If, st.loc(in.position()));
-        s->value = std::move(items[0].expr);
-        s->then_branch = std::move(items[1].stmt);
-        if (items.size() > 2) s->else_branch = std::move(items[2].stmt);
-        st.push_stmt(std::move(s), 1 + max_height(items));
+        Frame items = st.take();
+        auto s = make_stmt(StmtKind::If, st.loc_at(in.begin()));
+        s->value = own(items[0]);
+        s->then_branch = own_stmt(items[1]);
+        if (items.size > 2) s->else_branch = own_stmt(items[2]);
+        uint32_t h = 1 + max_height(items);
+        st.pop_frame();
+        st.push_stmt(std::move(s), h);
     }
 };
 
@@ -590,12 +735,12 @@ template <>
 struct action<g::for_stmt> {  // [bindings..., body]
     template <typename In>
     static void apply(const In& in, State& st) {
-        auto& items = st.take();
-        auto s = make_stmt(StmtKind::For, st.loc(in.position()));
+        Frame items = st.take();
+        auto s = make_stmt(StmtKind::For, st.loc_at(in.begin()));
         uint32_t h = 1 + max_height(items);
-        s->body = std::move(items.back().stmt);
-        items.pop_back();
-        s->bindings = take_bindings(items);
+        s->body = own_stmt(items.back());
+        s->bindings = take_bindings(items, items.size - 1);
+        st.pop_frame();
         st.push_stmt(std::move(s), h);
     }
 };
@@ -604,7 +749,7 @@ template <>
 struct action<g::empty_stmt> {
     template <typename In>
     static void apply(const In& in, State& st) {
-        st.push_stmt(make_stmt(StmtKind::Empty, st.loc(in.position())), 1);
+        st.push_stmt(make_stmt(StmtKind::Empty, st.loc_at(in.begin())), 1);
     }
 };
 
@@ -612,10 +757,12 @@ template <>
 struct action<g::expr_stmt> {
     template <typename In>
     static void apply(const In&, State& st) {
-        auto& items = st.take();
+        Frame items = st.take();
         auto s = make_stmt(StmtKind::Expr, items[0].loc);
-        s->value = std::move(items[0].expr);
-        st.push_stmt(std::move(s), items[0].height + 1);
+        s->value = own(items[0]);
+        uint32_t h = items[0].height + 1;
+        st.pop_frame();
+        st.push_stmt(std::move(s), h);
     }
 };
 
@@ -664,15 +811,19 @@ struct base_control : pegtl::normal<Rule> {
         } guard{nullptr};
         if constexpr (nests) {
             if (st.depth >= st.max_depth)
-                throw CompileError(st.loc(in.position()), fmt::format("nesting deeper than {} levels", st.max_depth));
+                throw CompileError(st.loc_at(in.current()), fmt::format("nesting deeper than {} levels", st.max_depth));
             ++st.depth;
             guard.depth = &st.depth;
         }
         const size_t mark = st.items.size();
-        if constexpr (framed) st.frames.push_back(mark);
+        size_t outer_frame = 0;
+        if constexpr (framed) {
+            outer_frame = st.frame;
+            st.frame = mark;
+        }
         const bool ok = pegtl::normal<Rule>::template match<A, mode, Action, Control>(in, st);
-        if constexpr (framed) st.frames.pop_back();
-        if (!ok && st.items.size() > mark) st.items.resize(mark);
+        if constexpr (framed) st.frame = outer_frame;
+        if (!ok && st.items.size() > mark) st.truncate(mark);
         return ok;
     }
 };
@@ -764,7 +915,88 @@ CompileError syntax_error(const SourceFile& f, size_t off, std::string msg) {
     return CompileError(loc_at(f, off), std::move(msg));
 }
 
+// ---------------------------------------------------------------- node allocation
+
+// Fixed-size slots for one node type: a free list of deleted slots, else the next slot of
+// the current chunk. Chunks are never released (a thread reuses its freed slots), and are
+// all kept on one global list so that leak checkers see them as reachable. Under
+// AddressSanitizer nodes use the ordinary heap, so it still finds use-after-free.
+#if defined(__SANITIZE_ADDRESS__)
+#define SDFC_NODE_POOL 0
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SDFC_NODE_POOL 0
+#endif
+#endif
+#ifndef SDFC_NODE_POOL
+#define SDFC_NODE_POOL 1
+#endif
+
+struct PoolChunk {
+    PoolChunk* next;
+};
+std::atomic<PoolChunk*> all_chunks{nullptr};
+
+template <size_t Size>
+class NodePool {
+    static constexpr size_t kChunkSlots = 256;
+    struct Slot {
+        Slot* next;
+    };
+    Slot* free_ = nullptr;
+    char* next_ = nullptr;
+    char* end_ = nullptr;
+
+    void refill() {
+        constexpr size_t header = (sizeof(PoolChunk) + alignof(std::max_align_t) - 1) / alignof(std::max_align_t) *
+                                  alignof(std::max_align_t);
+        char* mem = static_cast<char*>(::operator new(header + kChunkSlots * Size));
+        auto* chunk = reinterpret_cast<PoolChunk*>(mem);
+        chunk->next = all_chunks.load(std::memory_order_relaxed);
+        while (!all_chunks.compare_exchange_weak(chunk->next, chunk, std::memory_order_release, std::memory_order_relaxed)) {
+        }
+        next_ = mem + header;
+        end_ = next_ + kChunkSlots * Size;
+    }
+
+public:
+    void* get() {
+        if (free_) return std::exchange(free_, free_->next);
+        if (next_ == end_) refill();
+        return std::exchange(next_, next_ + Size);
+    }
+    void put(void* p) noexcept { free_ = ::new (p) Slot{free_}; }
+};
+
+constexpr size_t slot_size(size_t n) { return (n + 15) / 16 * 16; }
+thread_local NodePool<slot_size(sizeof(Expr))> expr_pool;
+thread_local NodePool<slot_size(sizeof(Stmt))> stmt_pool;
+
 }  // namespace
+
+#if SDFC_NODE_POOL
+void* Expr::operator new(std::size_t size) { return size == sizeof(Expr) ? expr_pool.get() : ::operator new(size); }
+void Expr::operator delete(void* p, std::size_t size) noexcept {
+    if (!p) return;
+    if (size == sizeof(Expr))
+        expr_pool.put(p);
+    else
+        ::operator delete(p);
+}
+void* Stmt::operator new(std::size_t size) { return size == sizeof(Stmt) ? stmt_pool.get() : ::operator new(size); }
+void Stmt::operator delete(void* p, std::size_t size) noexcept {
+    if (!p) return;
+    if (size == sizeof(Stmt))
+        stmt_pool.put(p);
+    else
+        ::operator delete(p);
+}
+#else
+void* Expr::operator new(std::size_t size) { return ::operator new(size); }
+void Expr::operator delete(void* p, std::size_t) noexcept { ::operator delete(p); }
+void* Stmt::operator new(std::size_t size) { return ::operator new(size); }
+void Stmt::operator delete(void* p, std::size_t) noexcept { ::operator delete(p); }
+#endif
 
 std::unique_ptr<Module> parse(const SourceFile& file, const ParseOptions& opts) {
     State st;
@@ -773,8 +1005,11 @@ std::unique_ptr<Module> parse(const SourceFile& file, const ParseOptions& opts) 
     // Operator chains make trees taller than their nesting; later stages recurse over the
     // tree, so its height is bounded too.
     st.max_height = std::max(4 * st.max_depth, 64u);
-    pegtl::memory_input<pegtl::tracking_mode::eager, pegtl::eol::lf_crlf> in(file.text.data(), file.text.size(),
-                                                                            file.path);
+    st.text = file.text.data();
+    st.line_starts = file.line_starts.data();
+    st.line_count = file.line_starts.size();
+    pegtl::memory_input<pegtl::tracking_mode::lazy, pegtl::eol::lf_crlf, const char*> in(
+        file.text.data(), file.text.size(), file.path.c_str());
     try {
         pegtl::parse<g::grammar, action, control>(in, st);
     } catch (const pegtl::parse_error& e) {
@@ -783,7 +1018,8 @@ std::unique_ptr<Module> parse(const SourceFile& file, const ParseOptions& opts) 
     }
     auto m = std::make_unique<Module>();
     m->file = &file;
-    for (auto& it : st.items) m->stmts.push_back(std::move(it.stmt));
+    m->stmts.reserve(st.items.size());
+    for (auto& it : st.items) m->stmts.push_back(own_stmt(it));
     return m;
 }
 

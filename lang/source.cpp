@@ -1,6 +1,10 @@
 #include "lang/source.hpp"
 
+#include <pthread.h>
+
 #include <algorithm>
+#include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -26,10 +30,24 @@ std::string format_diagnostic(const Diagnostic& d) {
     if (!d.loc.known()) return fmt::format("sdfc: error: {}\n", d.message);
     std::string out = fmt::format("{}:{}:{}: error: {}\n", d.loc.file->path, d.loc.line, d.loc.col, d.message);
     std::string_view src = d.loc.file->line(d.loc.line);
-    out += src;
+    // A very long line (minified or generated text) is shown as a window around the column.
+    constexpr size_t kWindow = 160;
+    size_t col = std::min<size_t>(d.loc.col - 1, src.size()), b = 0, e = src.size();
+    auto continuation = [&](size_t i) { return (static_cast<unsigned char>(src[i]) & 0xC0) == 0x80; };
+    if (src.size() > 2 * kWindow) {
+        b = col > kWindow / 2 ? col - kWindow / 2 : 0;
+        while (b > 0 && continuation(b)) --b;
+        e = std::min(src.size(), b + kWindow);
+        while (e < src.size() && continuation(e)) ++e;
+    }
+    std::string_view lead = b > 0 ? "..." : "";
+    out += lead;
+    out += src.substr(b, e - b);
+    if (e < src.size()) out += "...";
     out += '\n';
     // Keep tabs so the caret lines up in a terminal.
-    for (uint32_t i = 1; i < d.loc.col && i - 1 < src.size(); ++i) out += src[i - 1] == '\t' ? '\t' : ' ';
+    out.append(lead.size(), ' ');
+    for (size_t i = b; i < col; ++i) out += src[i] == '\t' ? '\t' : ' ';
     out += "^\n";
     return out;
 }
@@ -46,14 +64,23 @@ CompileError::CompileError(std::vector<Diagnostic> diags)
 CompileError::CompileError(Loc loc, std::string message)
     : CompileError(std::vector<Diagnostic>{Diagnostic{loc, std::move(message)}}) {}
 
+// Well-formed UTF-8 (Unicode table 3-7): no overlong forms, surrogates or code points
+// above U+10FFFF.
 static bool valid_utf8(std::string_view s, size_t& bad_at) {
     size_t i = 0;
     while (i < s.size()) {
         unsigned char c = static_cast<unsigned char>(s[i]);
-        size_t n = c < 0x80 ? 1 : (c >> 5) == 6 ? 2 : (c >> 4) == 14 ? 3 : (c >> 3) == 30 ? 4 : 0;
+        size_t n = c < 0x80 ? 1 : c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
         if (n == 0 || i + n > s.size()) { bad_at = i; return false; }
-        for (size_t k = 1; k < n; ++k)
-            if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80) { bad_at = i; return false; }
+        unsigned char lo = 0x80, hi = 0xBF;  // the second byte's range
+        if (c == 0xE0) lo = 0xA0;
+        if (c == 0xED) hi = 0x9F;
+        if (c == 0xF0) lo = 0x90;
+        if (c == 0xF4) hi = 0x8F;
+        for (size_t k = 1; k < n; ++k) {
+            unsigned char b = static_cast<unsigned char>(s[i + k]);
+            if (b < (k == 1 ? lo : 0x80) || b > (k == 1 ? hi : 0xBF)) { bad_at = i; return false; }
+        }
         i += n;
     }
     return true;
@@ -65,6 +92,11 @@ const SourceFile& SourceManager::add(std::string path, std::string text) {
 }
 
 const SourceFile& SourceManager::load(const std::string& path, Loc from, size_t max_bytes) {
+    // Only regular files: opening a FIFO would block, a device may never end.
+    std::error_code ec;
+    auto st = std::filesystem::status(path, ec);
+    if (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
+        throw CompileError(from, fmt::format("cannot read '{}': not a regular file", path));
     std::ifstream in(path, std::ios::binary);
     if (!in) throw CompileError(from, fmt::format("cannot open '{}'", path));
     in.seekg(0, std::ios::end);
@@ -77,6 +109,11 @@ const SourceFile& SourceManager::load(const std::string& path, Loc from, size_t 
     std::string text(static_cast<size_t>(size), '\0');
     if (size > 0 && !in.read(text.data(), size)) throw CompileError(from, fmt::format("cannot read '{}'", path));
     const SourceFile& f = add(path, std::move(text));
+    check_source_text(f);
+    return f;
+}
+
+void check_source_text(const SourceFile& f) {
     size_t nul = f.text.find('\0');
     size_t bad = 0;
     auto loc_of = [&](size_t off) {
@@ -86,14 +123,15 @@ const SourceFile& SourceManager::load(const std::string& path, Loc from, size_t 
     };
     if (nul != std::string::npos) throw CompileError(loc_of(nul), "binary file: NUL byte in source text");
     if (!valid_utf8(f.text, bad)) throw CompileError(loc_of(bad), "invalid UTF-8 in source text");
-    return f;
 }
 
 std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates) {
     std::string best;
+    if (name.empty() || name.size() > 64) return best;  // no typo of a known name; keeps this cheap
     // Close enough to be a typo: at most a third of the name wrong, and never all of it.
     size_t best_d = std::min(std::max<size_t>(1, name.size() / 3), name.size() - 1) + 1;
     for (const auto& c : candidates) {
+        if ((c.size() > name.size() ? c.size() - name.size() : name.size() - c.size()) >= best_d) continue;
         std::vector<size_t> prev(c.size() + 1), cur(c.size() + 1);
         for (size_t j = 0; j <= c.size(); ++j) prev[j] = j;
         for (size_t i = 1; i <= name.size(); ++i) {
@@ -105,6 +143,39 @@ std::string nearest_name(std::string_view name, const std::vector<std::string>& 
         if (prev[c.size()] < best_d) { best_d = prev[c.size()]; best = c; }
     }
     return best;
+}
+
+namespace {
+
+// The lowest usable address of this thread's stack (0 when unknown: no check).
+uintptr_t stack_low() {
+    thread_local const uintptr_t low = [] {
+        pthread_attr_t a;
+        if (pthread_getattr_np(pthread_self(), &a) != 0) return uintptr_t(0);
+        void* addr = nullptr;
+        size_t size = 0;
+        int r = pthread_attr_getstack(&a, &addr, &size);
+        pthread_attr_destroy(&a);
+        return r == 0 ? reinterpret_cast<uintptr_t>(addr) : uintptr_t(0);
+    }();
+    return low;
+}
+
+}  // namespace
+
+bool stack_nearly_exhausted() {
+    // Far more than any stage uses between two checks (or to throw and unwind), even
+    // with sanitizers' larger frames.
+    constexpr uintptr_t kMargin = 512u << 10;
+    const uintptr_t low = stack_low();
+    const auto here = reinterpret_cast<uintptr_t>(__builtin_frame_address(0));
+    return low != 0 && here < low + kMargin;
+}
+
+void check_stack(Loc loc) {
+    if (stack_nearly_exhausted())
+        throw CompileError(loc, "nested too deeply: the C++ stack is nearly exhausted (simplify the script, "
+                                "or run with a larger stack: ulimit -s)");
 }
 
 }  // namespace sdfc

@@ -52,6 +52,9 @@ private:
     std::string formatted_;
 };
 
+// Throws CompileError at the first NUL byte (a binary file) or invalid UTF-8 sequence.
+void check_source_text(const SourceFile& f);
+
 // Owns every loaded file so Locs stay valid for the whole compilation.
 class SourceManager {
 public:
@@ -66,5 +69,12 @@ private:
 
 // Levenshtein-nearest candidate within a small distance, or "" (for "did you mean").
 std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates);
+
+// Every recursive stage (parser, interpreter, lowering) calls this once per level: it
+// throws CompileError at `loc` when the current thread's C++ stack is nearly used up, so
+// input nested deeper than the stack allows is a diagnostic, never a stack overflow,
+// whatever the limits (--max-nesting, --max-recursion, --max-shape-depth) are raised to.
+void check_stack(Loc loc);
+bool stack_nearly_exhausted();  // the test alone (when making the Loc costs something)
 
 }  // namespace sdfc

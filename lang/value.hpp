@@ -43,6 +43,7 @@ struct RangeVal {
 struct Value {
     VT t = VT::None;
     uint8_t n = 0;                 // components of Number (1), Bool (1), Vector (2-4)
+    uint32_t depth = 0;            // List: lists nested inside, plus one (bounded by max_nesting)
     std::array<NodeId, 4> c{};
     RangeVal range;
     std::shared_ptr<const std::vector<Value>> list;

@@ -1,6 +1,7 @@
 // The flat SSA format of the Prospero Challenge: `NAME OPCODE ARGS...` per line, `#`
 // comments, the last line is the output. Read into the IR like any script's field.
 #include <charconv>
+#include <cmath>
 #include <sstream>
 #include <unordered_map>
 
@@ -77,6 +78,7 @@ Scene load_vm(SourceManager&, const SourceFile& file) {
             char* end = nullptr;
             in.k = std::strtof(s.c_str(), &end);
             if (end != s.c_str() + s.size()) throw CompileError(loc(2), fmt::format("'{}' is not a number", s));
+            if (!std::isfinite(in.k)) throw CompileError(loc(2), fmt::format("'{}' is not a finite number", s));
         } else {
             for (int j = 0; j < in.op.arity; ++j) {
                 auto it = names.find(std::string(tok[2 + j].first));

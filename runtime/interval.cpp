@@ -417,26 +417,27 @@ void Tape::recount() {
 
 void Tape::link() {
     const size_t n = code.size();
-    def.resize(n * 3);
-    slot.resize(n);
+    links.resize(n);
     thread_local std::vector<uint32_t> last;
     last.assign(std::max<uint32_t>(num_regs, uint32_t(out) + 1), kNone);
     uint32_t sl = 0;
+    uint32_t missing = 0;  // operands read before any write
     for (size_t i = 0; i < n; ++i) {
         const Instr& in = code[i];
         const int ar = kOpInfo[int(in.op)].arity;
-        def[3 * i + 0] = ar > 0 ? last[in.a] : kNone;
-        def[3 * i + 1] = ar > 1 ? last[in.b] : kNone;
-        def[3 * i + 2] = ar > 2 ? last[in.c] : kNone;
-        slot[i] = is_choice_op(in.op) ? sl++ : kNone;
+        Link& l = links[i];
+        l.def[0] = ar > 0 ? last[in.a] : kNone;
+        l.def[1] = ar > 1 ? last[in.b] : kNone;
+        l.def[2] = ar > 2 ? last[in.c] : kNone;
+        missing |= (ar > 0 && l.def[0] == kNone) | (ar > 1 && l.def[1] == kNone) | (ar > 2 && l.def[2] == kNone);
+        const bool ch = is_choice_op(in.op);
+        l.slot = ch ? sl : kNone;
+        sl += ch;
         last[in.out] = uint32_t(i);
     }
     choices = sl;
     out_def = last[out];
-    // A tape reading a register nobody wrote cannot be followed by def links.
-    linked = true;
-    for (size_t i = 0; i < n; ++i)
-        for (int j = 0; j < kOpInfo[int(code[i].op)].arity; ++j) linked &= def[3 * i + size_t(j)] != kNone;
+    linked = !missing;  // a tape reading unwritten registers cannot be followed by def links
 }
 
 IntervalEvaluator::IntervalEvaluator(uint32_t max_regs, uint32_t max_choices)
@@ -544,63 +545,72 @@ void simplify(const Tape& parent, const uint8_t* choices, int stride, int lane, 
     auto release = [&](uint16_t r) { free_regs[nfree++] = r; };
     uint64_t* live = s.live.data();
     uint16_t* bind = s.bind.data();
-    auto mark = [&](uint32_t d) { live[d >> 6] |= uint64_t(1) << (d & 63); };
-    auto is_live = [&](uint32_t d) { return (live[d >> 6] >> (d & 63)) & 1; };
-    mark(parent.out_def);
-    bind[parent.out_def] = alloc();
     const uint8_t* cp = choices + lane;
     const Instr* code = parent.code.data();
-    const uint32_t* defs = parent.def.data();
-    const uint32_t* slots = parent.slot.data();
+    const Tape::Link* links = parent.links.data();
+    {
+        const uint32_t o = parent.out_def;
+        live[o >> 6] |= uint64_t(1) << (o & 63);
+        bind[o] = alloc();
+    }
+    // The register holding the value of instruction d, allocating one at its last use
+    // (the first met walking backwards).
+    auto use = [&](uint32_t d) -> uint16_t {
+        uint64_t& w = live[d >> 6];
+        const uint64_t bit = uint64_t(1) << (d & 63);
+        if (!(w & bit)) {
+            w |= bit;
+            bind[d] = alloc();
+        }
+        return bind[d];
+    };
     for (size_t w = words; w-- > 0;) {
-        while (live[w]) {
-            const int b = 63 - __builtin_clzll(live[w]);
-            live[w] &= ~(uint64_t(1) << b);
+        uint64_t word;
+        while ((word = live[w]) != 0) {
+            const int b = 63 - __builtin_clzll(word);
+            live[w] = word & ~(uint64_t(1) << b);
             const uint32_t i = uint32_t(w * 64 + size_t(b));
-            const Instr& in = code[i];
+            const Instr in = code[i];
+            const Tape::Link& l = links[i];
             const uint16_t X = bind[i];
-            const uint32_t sl = slots[i];
-            const uint8_t ch = sl != Tape::kNone ? cp[size_t(sl) * size_t(stride)] : uint8_t(kChoiceBoth);
-            if (ch != kChoiceBoth) {
-                if ((in.op == Op::MinI || in.op == Op::MaxI) && ch == kChoiceB) {
-                    Instr c{Op::Const};
-                    c.out = X;
-                    c.k = in.k;
-                    rev[nrev++] = c;
-                    release(X);
+            if (l.slot != Tape::kNone) {
+                const uint8_t ch = cp[size_t(l.slot) * size_t(stride)];
+                if (ch != kChoiceBoth) {
+                    if (ch == kChoiceB && (in.op == Op::MinI || in.op == Op::MaxI)) {
+                        Instr c{Op::Const};
+                        c.out = X;
+                        c.k = in.k;
+                        rev[nrev++] = c;
+                        release(X);
+                        continue;
+                    }
+                    const uint32_t d = l.def[ch - 1];
+                    uint64_t& dw = live[d >> 6];
+                    const uint64_t bit = uint64_t(1) << (d & 63);
+                    if (!(dw & bit)) {
+                        dw |= bit;
+                        bind[d] = X;  // the winner's value lives in X: no instruction
+                    } else {
+                        Instr c{Op::Copy};
+                        c.out = X;
+                        c.a = bind[d];
+                        rev[nrev++] = c;
+                        release(X);
+                    }
                     continue;
                 }
-                const uint32_t d = defs[3 * i + (ch == kChoiceA ? 0 : (ch == kChoiceB ? 1 : 2))];
-                if (!is_live(d)) {
-                    mark(d);
-                    bind[d] = X;  // the winner's value lives in X: no instruction
-                } else {
-                    Instr c{Op::Copy};
-                    c.out = X;
-                    c.a = bind[d];
-                    rev[nrev++] = c;
-                    release(X);
-                }
-                continue;
+                ++nch;
             }
-            release(X);
-            Instr e = in;
+            release(X);  // before the operands: the result may reuse an operand's register
+            Instr e{in.op};
             e.out = X;
-            const int arity = kOpInfo[int(in.op)].arity;
-            uint16_t* ops[3] = {&e.a, &e.b, &e.c};
-            for (int j = 0; j < 3; ++j) {
-                if (j >= arity) {
-                    *ops[j] = 0;
-                    continue;
-                }
-                const uint32_t d = defs[3 * i + size_t(j)];
-                if (!is_live(d)) {
-                    mark(d);
-                    bind[d] = alloc();
-                }
-                *ops[j] = bind[d];
+            e.k = in.k;
+            switch (kOpInfo[int(in.op)].arity) {
+                case 3: e.c = use(l.def[2]); [[fallthrough]];
+                case 2: e.b = use(l.def[1]); [[fallthrough]];
+                case 1: e.a = use(l.def[0]); break;
+                default: break;
             }
-            nch += (kChoiceMask >> int(in.op)) & 1;
             rev[nrev++] = e;
         }
     }

@@ -43,15 +43,19 @@ struct Tape {
     uint16_t out = 0;        // output register
     uint32_t num_regs = 1;   // registers used (a VM register file this big suffices)
     uint32_t choices = 0;    // instructions with is_choice_op, in order: their "slots"
-    // link():
-    std::vector<uint32_t> def;   // 3 per instruction: defining instruction of a, b, c (kNone: unused)
-    std::vector<uint32_t> slot;  // per instruction: its choice slot (kNone: not a choice op)
+    // link(): per instruction, the instructions defining its operands a, b, c (kNone: unused)
+    // and its choice slot (kNone: not a choice op).
+    struct Link {
+        uint32_t def[3];
+        uint32_t slot;
+    };
+    std::vector<Link> links;
     uint32_t out_def = kNone;    // the instruction defining the output
     bool linked = false;
 
     static Tape from(const Program& p, int output = 0);
     void recount();  // sets num_regs and choices from code
-    void link();     // fills def, slot, out_def (needs scratch the size of num_regs)
+    void link();     // fills links and out_def
 };
 
 inline constexpr int kIvLanes = 64;

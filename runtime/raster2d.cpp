@@ -28,6 +28,9 @@
 #include "runtime/slice.hpp"
 #include "runtime/vm.hpp"
 
+// GCC cannot see that the evaluators read only the first n lanes of their inputs.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+
 namespace sdfc {
 namespace {
 std::atomic<uint64_t> g_ns[16], g_ivns[16], g_leafns[16];
@@ -111,7 +114,8 @@ void fill(Ctx& c, int x0, int y0, int x1, int y1, float v) {
 void leaf(Ctx& c, Scratch& s, const Tape& t, int x0, int y0) {
     const int x1 = std::min(x0 + kLeaf, c.w), y1 = std::min(y0 + kLeaf, c.h);
     const int cols = x1 - x0, rows = y1 - y0, n = cols * rows;
-    float xs[kBatch] = {}, ys[kBatch] = {}, zs[kBatch] = {};
+    float xs[kBatch], ys[kBatch], zs[kBatch];  // lanes >= n are never read
+    std::fill_n(zs, n, 0.0f);
     for (int r = 0; r < rows; ++r) {
         const float yv = coord_y(y0 + r, c.h);
         for (int q = 0; q < cols; ++q) {
@@ -138,7 +142,7 @@ void process(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0, int size) {
     if (!t.linked) t.link();
     const int child = size >= 128 ? size / 4 : kLeaf;
     const int per_axis = size / child;
-    float bx[6][kIvLanes] = {};
+    float bx[6][kIvLanes];  // lanes >= n are never read (the evaluators pad from lane n - 1)
     int cx[kIvLanes], cy[kIvLanes];
     int n = 0;
     for (int j = 0; j < per_axis; ++j) {
