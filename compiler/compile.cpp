@@ -9,6 +9,18 @@
 
 namespace sdfc {
 
+void set_default_settings(Scene& s) {
+    Graph& g = *s.graph;
+    auto v3 = [&](float x, float y, float z) { return Vec3N{g.constant(x), g.constant(y), g.constant(z)}; };
+    s.camera.position = v3(0, 0, 5);
+    s.camera.target = v3(0, 0, 0);
+    s.camera.up = v3(0, 1, 0);
+    s.camera.fov = g.constant(45);
+    s.camera.ortho_height = g.constant(2);
+    s.ambient = v3(0.05f, 0.05f, 0.05f);
+    s.background = v3(0, 0, 0);
+}
+
 LoweredScene lower_scene(Graph& g, const Scene& scene) {
     Vec3N p{g.input(Op::VarX), g.input(Op::VarY), g.input(Op::VarZ)};
     LoweredScene out;

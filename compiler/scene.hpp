@@ -102,4 +102,8 @@ struct Scene {
     std::shared_ptr<void> keepalive;  // what field closures need (the interpreter's state)
 };
 
+// Sets the settings of LANGUAGE.md section 8's defaults (camera at [0, 0, 5] looking at
+// the origin, fov 45, ambient 0.05, black background) as constants of scene.graph.
+void set_default_settings(Scene& scene);
+
 }  // namespace sdfc

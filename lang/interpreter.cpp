@@ -138,14 +138,7 @@ ShapePtr Interp::to_shape(const Value& v, Loc loc, const char* what) {
 
 Scene Interp::run(const SourceFile& file) {
     scene.graph = g;
-    auto& gr = *g;
-    scene.camera.position = {gr.constant(0), gr.constant(0), gr.constant(5)};
-    scene.camera.target = {gr.constant(0), gr.constant(0), gr.constant(0)};
-    scene.camera.up = {gr.constant(0), gr.constant(1), gr.constant(0)};
-    scene.camera.fov = gr.constant(45);
-    scene.camera.ortho_height = gr.constant(2);
-    scene.ambient = {gr.constant(0.05f), gr.constant(0.05f), gr.constant(0.05f)};
-    scene.background = {gr.constant(0), gr.constant(0), gr.constant(0)};
+    set_default_settings(scene);
     scene.time = opts.time.value_or(0.0f);
 
     modules.push_back(ast::parse(file, ast::ParseOptions{opts.limits.max_nesting}));

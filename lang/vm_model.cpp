@@ -115,11 +115,10 @@ Scene load_vm(SourceManager&, const SourceFile& file) {
     s.root = std::make_shared<const Shape>(std::move(f));
     s.is_2d = !uses_z;
     s.raw_field = true;
-    s.camera.position = {g.constant(0), g.constant(0), g.constant(3.5f)};
-    s.camera.target = {g.constant(0), g.constant(0), g.constant(0)};
-    s.camera.up = {g.constant(0), g.constant(1), g.constant(0)};
+    set_default_settings(s);
+    // Models live in [-1, 1]^3: a closer camera than a script's default.
+    s.camera.position[2] = g.constant(3.5f);
     s.camera.fov = g.constant(40);
-    s.camera.ortho_height = g.constant(2);
     s.ambient = {g.constant(0.08f), g.constant(0.08f), g.constant(0.08f)};
     s.background = {g.constant(0.02f), g.constant(0.02f), g.constant(0.03f)};
     s.render.width = 1024;

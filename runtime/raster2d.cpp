@@ -105,43 +105,51 @@ struct Ctx {
     float* px;  // w * h, one channel
     float time;
     Pool* pool;
+    std::vector<int> sizes;  // tile size per depth: sizes[0] the root, the last the leaves
+    bool simplify_leaves = true;
 };
 
 void fill(Ctx& c, int x0, int y0, int x1, int y1, float v) {
     for (int y = y0; y < y1; ++y) std::fill(c.px + size_t(y) * c.w + x0, c.px + size_t(y) * c.w + x1, v);
 }
 
-void leaf(Ctx& c, Scratch& s, const Tape& t, int x0, int y0) {
-    const int x1 = std::min(x0 + kLeaf, c.w), y1 = std::min(y0 + kLeaf, c.h);
-    const int cols = x1 - x0, rows = y1 - y0, n = cols * rows;
-    float xs[kBatch], ys[kBatch], zs[kBatch];  // lanes >= n are never read
-    std::fill_n(zs, n, 0.0f);
-    for (int r = 0; r < rows; ++r) {
-        const float yv = coord_y(y0 + r, c.h);
-        for (int q = 0; q < cols; ++q) {
-            xs[r * cols + q] = coord_x(x0 + q, c.w);
-            ys[r * cols + q] = yv;
+// Pixels of the tile [x0, x0 + size)^2 (clipped), 8 x 8 pixels per VM batch.
+void leaf(Ctx& c, Scratch& s, const Tape& t, int x0, int y0, int size) {
+    for (int by = y0; by < std::min(y0 + size, c.h); by += 8)
+        for (int bx = x0; bx < std::min(x0 + size, c.w); bx += 8) {
+            const int x1 = std::min(bx + 8, c.w), y1 = std::min(by + 8, c.h);
+            const int cols = x1 - bx, rows = y1 - by, n = cols * rows;
+            float xs[kBatch], ys[kBatch], zs[kBatch];  // lanes >= n are never read
+            std::fill_n(zs, n, 0.0f);
+            for (int r = 0; r < rows; ++r) {
+                const float yv = coord_y(by + r, c.h);
+                for (int q = 0; q < cols; ++q) {
+                    xs[r * cols + q] = coord_x(bx + q, c.w);
+                    ys[r * cols + q] = yv;
+                }
+            }
+            s.ev.eval_code(t.code.data(), t.code.size(), xs, ys, zs, n, c.time);
+            const float* d = s.ev.reg_data(t.out);
+            for (int r = 0; r < rows; ++r) {
+                float* row = c.px + size_t(by + r) * c.w + bx;
+                for (int q = 0; q < cols; ++q) row[q] = d[r * cols + q] < 0.0f ? 1.0f : 0.0f;
+            }
+            s.points += uint64_t(n);
         }
-    }
-    s.ev.eval_code(t.code.data(), t.code.size(), xs, ys, zs, n, c.time);
-    const float* d = s.ev.reg_data(t.out);
-    for (int r = 0; r < rows; ++r) {
-        float* row = c.px + size_t(y0 + r) * c.w + x0;
-        for (int q = 0; q < cols; ++q) row[q] = d[r * cols + q] < 0.0f ? 1.0f : 0.0f;
-    }
-    s.points += uint64_t(n);
 }
 
-// The tile [x0, x0 + size)^2 (clipped to the image), whose tape is `t`, on scratch `s` at
-// recursion depth `depth`.
-void process(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0, int size) {
-    if (size <= kLeaf) {
-        leaf(c, s, t, x0, y0);
+// The tile [x0, x0 + size)^2 (clipped to the image) at recursion depth `depth`, whose tape
+// is `t`, on scratch `s`.
+void process(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0) {
+    const int size = c.sizes[size_t(depth)];
+    if (size_t(depth) + 1 == c.sizes.size()) {
+        leaf(c, s, t, x0, y0, size);
         return;
     }
     if (!t.linked) t.link();
-    const int child = size >= 128 ? size / 4 : kLeaf;
+    const int child = c.sizes[size_t(depth) + 1];
     const int per_axis = size / child;
+    const bool child_is_leaf = size_t(depth) + 2 == c.sizes.size();
     float bx[6][kIvLanes];  // lanes >= n are never read (the evaluators pad from lane n - 1)
     int cx[kIvLanes], cy[kIvLanes];
     int n = 0;
@@ -170,10 +178,9 @@ void process(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0, int size) {
     int todo[kIvLanes], m = 0;
     for (int k = 0; k < n; ++k) {
         const Interval r = iv.result(k);
-        const int x1 = std::min(cx[k] + child, c.w), y1 = std::min(cy[k] + child, c.h);
-        if (r.hi < 0.0f) fill(c, cx[k], cy[k], x1, y1, 1.0f);
-        else if (r.lo >= 0.0f) fill(c, cx[k], cy[k], x1, y1, 0.0f);
-        else todo[m++] = k;  // straddles the surface, or unknown (NaN)
+        if (r.hi < 0.0f) fill(c, cx[k], cy[k], std::min(cx[k] + child, c.w), std::min(cy[k] + child, c.h), 1.0f);
+        else if (!(r.lo >= 0.0f)) todo[m++] = k;  // straddles the surface, or unknown (NaN)
+        // else: outside, and the image starts black
     }
     if (child >= 64 && m > 1) {
         tbb::parallel_for(0, m, [&](int q) {
@@ -182,7 +189,7 @@ void process(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0, int size) {
             Tape& ct = s2->tapes[size_t(depth) + 1];
             simplify(t, iv.choices(), iv.stride(), k, ct, s2->ss);
             g_calls[depth]++; g_in[depth] += t.code.size(); g_out[depth] += ct.code.size();
-            process(c, *s2, depth + 1, ct, cx[k], cy[k], child);
+            process(c, *s2, depth + 1, ct, cx[k], cy[k]);
             c.pool->release(s2);
         });
         return;
@@ -190,9 +197,13 @@ void process(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0, int size) {
     Tape& ct = s.tapes[size_t(depth) + 1];
     for (int q = 0; q < m; ++q) {
         const int k = todo[q];
+        if (child_is_leaf && !c.simplify_leaves) {
+            leaf(c, s, t, cx[k], cy[k], child);
+            continue;
+        }
         simplify(t, iv.choices(), iv.stride(), k, ct, s.ss);
         g_calls[depth]++; g_in[depth] += t.code.size(); g_out[depth] += ct.code.size();
-        process(c, s, depth + 1, ct, cx[k], cy[k], child);
+        process(c, s, depth + 1, ct, cx[k], cy[k]);
     }
 }
 
@@ -238,8 +249,21 @@ Image render_2d(const CompiledScene& scene, int w, int h, int threads, bool base
     c.pool = &pool;
     int size = kLeaf;
     while (size < w || size < h) size *= 2;
+    c.sizes.push_back(size);
+    if (const char* e = std::getenv("SDFC_2D_SCHEDULE")) {
+        for (const char* p = e; *p;) {
+            int v = std::atoi(p);
+            if (v > 0 && v < c.sizes.back()) c.sizes.push_back(v);
+            while (*p && *p != ',') ++p;
+            if (*p) ++p;
+        }
+    } else {
+        while (c.sizes.back() >= 128) c.sizes.push_back(c.sizes.back() / 4);
+        if (c.sizes.back() > kLeaf) c.sizes.push_back(kLeaf);
+    }
+    if (const char* e = std::getenv("SDFC_2D_LEAFSIMP")) c.simplify_leaves = std::atoi(e) != 0;
     Scratch* s = pool.acquire();
-    process(c, *s, 0, root, 0, 0, size);
+    process(c, *s, 0, root, 0, 0);
     pool.release(s);
     if (stats) stats->distance_points = pool.points();
     if (std::getenv("SDFC_DEBUG2D")) for (int d = 0; d < 6; ++d) if (g_calls[d] || g_iv[d] || g_leafns[d]) std::fprintf(stderr, "depth %d: iv %.2fms simp %.2fms leaf %.2fms | iv instrs %lu lanes %lu | simplify calls %lu in %lu out %lu\n", d, g_ivns[d]*1e-6, g_ns[d]*1e-6, g_leafns[d]*1e-6, (unsigned long)g_iv[d], (unsigned long)g_ivl[d], (unsigned long)g_calls[d], (unsigned long)g_in[d], (unsigned long)g_out[d]);
