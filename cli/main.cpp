@@ -69,10 +69,10 @@ Common read_common(Args& a) {
     }
     if (auto v = a.value("--max-calls")) l.max_calls = size_t(Args::to_int("--max-calls", *v, 1, 2000000000));
     if (auto v = a.value("--max-shapes")) l.max_shapes = size_t(Args::to_int("--max-shapes", *v, 1, 2000000000));
-    if (auto v = a.value("--max-shape-depth")) l.max_shape_depth = Args::to_int("--max-shape-depth", *v, 1, 100000);
+    if (auto v = a.value("--max-shape-depth")) l.max_shape_depth = Args::to_int("--max-shape-depth", *v, 1, 10000);
     if (auto v = a.value("--max-ops")) l.max_ops = size_t(Args::to_int("--max-ops", *v, 1, 2000000000));
     if (auto v = a.value("--max-file-size")) l.max_file_bytes = size_t(Args::to_int("--max-file-size", *v, 1, 2000000000));
-    if (auto v = a.value("--max-nesting")) l.max_nesting = Args::to_int("--max-nesting", *v, 1, 100000);
+    if (auto v = a.value("--max-nesting")) l.max_nesting = Args::to_int("--max-nesting", *v, 1, 10000);
     if (auto v = a.value("--max-pixels")) c.max_pixels = Args::to_int("--max-pixels", *v, 1, 2000000000);
     if (auto v = a.value("--max-frames")) c.max_frames = Args::to_int("--max-frames", *v, 1, 100000000);
     return c;
@@ -98,6 +98,8 @@ std::string expand(std::string out, int frame, const std::string& name) {
         if (!spec.empty() && spec.back() == 'd') {
             std::string digits = spec.substr(0, spec.size() - 1);
             width = digits.empty() ? 0 : std::atoi(digits.c_str());
+            if (digits.size() > 2 || width < 0 || width > 32)
+                throw UsageError(fmt::format("unsupported frame format '{{frame:{}}}' (at most 32 digits)", spec));
         } else {
             throw UsageError(fmt::format("unsupported frame format '{{frame:{}}}' (use {{frame:04d}})", spec));
         }
@@ -109,9 +111,10 @@ std::string expand(std::string out, int frame, const std::string& name) {
 }
 
 void apply_overrides(CompiledScene& cs, Args& a, Common& c) {
-    if (auto v = a.value("--width")) cs.render.width = Args::to_int("--width", *v, 1, 65536);
-    if (auto v = a.value("--height")) cs.render.height = Args::to_int("--height", *v, 1, 65536);
-    if (auto v = a.value("--samples")) cs.render.samples = Args::to_int("--samples", *v, 1, 4096);
+    bool sized = false;  // the size comes from flags, not (only) from the script
+    if (auto v = a.value("--width")) cs.render.width = Args::to_int("--width", *v, 1, 65536), sized = true;
+    if (auto v = a.value("--height")) cs.render.height = Args::to_int("--height", *v, 1, 65536), sized = true;
+    if (auto v = a.value("--samples")) cs.render.samples = Args::to_int("--samples", *v, 1, 4096), sized = true;
     if (auto v = a.value("--camera-position")) {
         auto f = Args::to_floats("--camera-position", *v, 3);
         cs.camera.position = {f[0], f[1], f[2]};
@@ -126,9 +129,13 @@ void apply_overrides(CompiledScene& cs, Args& a, Common& c) {
         cs.camera.fov = f;
     }
     double px = double(cs.render.width) * cs.render.height * cs.render.samples;
-    if (px > double(c.max_pixels))
-        throw UsageError(fmt::format("{}x{} pixels at {} samples is over the limit of {} (raise it with --max-pixels)",
-                                     cs.render.width, cs.render.height, cs.render.samples, c.max_pixels));
+    if (px > double(c.max_pixels)) {
+        std::string msg = fmt::format("{}x{} pixels at {} samples is over the limit of {} (raise it with --max-pixels)",
+                                      cs.render.width, cs.render.height, cs.render.samples, c.max_pixels);
+        // The script's render(...) chose the size: point at it.
+        if (!sized && cs.render.loc.known()) throw CompileError(cs.render.loc, msg);
+        throw UsageError(msg);
+    }
 }
 
 CompiledScene build(SourceManager& sm, const std::string& path, Common& c, std::optional<float> time) {

@@ -1,8 +1,9 @@
 // The GLSL twin of the CPU renderer (runtime/camera.cpp + runtime/tracer.cpp), pasted after
-// the scene functions by compiler/glsl.cpp. Same camera, marching rules, tetrahedral normals,
-// materials sanitising, Blinn-Phong, hard/soft shadows, AO, mirror/glass bounces (an
-// explicit stack instead of the CPU's ray wavefronts: GLSL has no recursion), background,
-// sRGB. Keep the two in step: tests/gpu compares the pictures.
+// the scene functions by compiler/glsl.cpp. Same camera, marching rules (over-relaxed sphere
+// tracing, cone tracing, raw-field bisection), tetrahedral normals, materials sanitising,
+// Blinn-Phong, hard/soft shadows, AO, mirror/glass bounces (an explicit stack instead of the
+// CPU's ray wavefronts: GLSL has no recursion), background, sRGB. Keep the two in step:
+// tests/gpu compares the pictures.
 //
 // It expects, defined before it (compiler/glsl.cpp writes them from the scene):
 //   const int SDF_MAX_STEPS, SDF_MAX_BOUNCES, SDF_SAMPLES, SDF_NUM_LIGHTS;
@@ -57,6 +58,11 @@ float sdf_max3(vec3 v) { return max(v.x, max(v.y, v.z)); }
 float sdf_maxabs3(vec3 v) { return max(abs(v.x), max(abs(v.y), abs(v.z))); }
 float sdf_nonneg(float v) { return v > 0.0 ? (sdf_finite(v) ? v : 1e30) : 0.0; }
 float sdf_clamp01(float v) { return v > 0.0 ? (v < 1.0 ? v : 1.0) : 0.0; }
+
+// 0, but not a compile-time constant (set from the viewport size in sdf_render): loops that
+// call map() start from it so that shader compilers do not unroll them into many copies of
+// the scene (the Shadertoy idiom `min(iFrame, 0)`).
+int sdf_zero;
 
 // Camera (runtime/camera.cpp).
 vec3 sdf_eye, sdf_fwd, sdf_right, sdf_up;
@@ -155,141 +161,100 @@ void sdf_clip_ray(vec3 o, vec3 d, inout float t_min, inout float t_max) {
     if (!(t_min <= t_max)) t_min = sdf_inf();
 }
 
-// Raw fields (.vm models, no distance bound): steps of |f| / L (L a Lipschitz estimate made by
-// the compiler as the CPU renderer makes it), clamped to [one pixel footprint, SDF_RAW_MAX_STEP];
-// a sign change is refined by bisection to the outside end of the bracket. `shadow`: any sign
-// change is a hit.
-bool sdf_march_raw(vec3 o, vec3 d, float tmin, float tmax, float t0, bool inside, bool shadow, out float t) {
-    t = tmin;
-    if (!(t <= tmax)) { t = tmax; return false; }
-    float sg = inside ? -1.0 : 1.0;
-    float prev = -1.0, lo = 0.0, hi = 0.0, bisect = 0.0;
-    for (int steps = 1; steps <= SDF_MAX_STEPS; ++steps) {
-        float s = sg * map(o + t * d);
-        float path = t0 + t;
-        bool done = false, hit = false;
-        if (bisect > 0.0) {
-            if (s < 0.0) hi = t;
-            else lo = t;
-            bisect += 1.0;
-            if (bisect > 12.0 || hi - lo < sdf_thr(path)) {
-                t = lo;
-                done = hit = true;
-            } else {
-                t = 0.5 * (lo + hi);
-            }
-        } else if (s <= 0.0) {
-            if (s == 0.0 || prev < 0.0 || shadow) {
-                done = hit = true;
-            } else {
-                lo = prev;
-                hi = t;
-                bisect = 1.0;
-                t = 0.5 * (lo + hi);
-            }
-        } else {
-            float fp = sdf_footprint(path), step = fp;
-            if (!isnan(s)) {
-                float v = s * SDF_RAW_INV_LIPSCHITZ;
-                step = v < fp ? fp : (SDF_RAW_MAX_STEP < v ? SDF_RAW_MAX_STEP : v);
-            }
-            prev = t;
-            t = t + step;
-            done = !(t <= tmax);
-        }
-        if (!done && steps >= SDF_MAX_STEPS) {
-            done = true;
-            hit = bisect > 0.0;
-            if (hit) t = lo;
-        }
-        if (done) return hit;
-    }
-    return false;
-}
+// The marching rules, one distance value at a time (the tracer below owns the only map()
+// call, see sdf_trace). Each returns true when its march is over.
 
 // Over-relaxed sphere tracing (Keinert et al. 2014: omega = 1.5, back to 1 when consecutive
-// unbounding spheres stop overlapping), on -d inside a solid. Hit when d < epsilon *
-// max(path, 1); a ray out of steps hits when within one pixel footprint.
-bool sdf_march(vec3 o, vec3 d, float tmin, float tmax, float t0, bool inside, out float t) {
-    if (SDF_RAW) return sdf_march_raw(o, d, tmin, tmax, t0, inside, false, t);
-    t = tmin;
-    if (!(t <= tmax)) { t = tmax; return false; }
-    float sg = inside ? -1.0 : 1.0;
-    float om = SDF_RELAX, pr = 0.0, sl = 0.0;
-    for (int steps = 1; steps <= SDF_MAX_STEPS; ++steps) {
-        float s = sg * map(o + t * d);
-        float r = abs(s);
-        bool fail = om > 1.0 && r + pr < sl;
-        float step = fail ? (1.0 - om) * sl : om * s;
-        om = fail ? 1.0 : om;
-        sl = step;
-        pr = r;
-        bool stop = (s < SDF_EPSILON * max(t0 + t, 1.0) && !fail) || steps >= SDF_MAX_STEPS;
-        float tn = t + step;
-        bool past = !(tn <= tmax);
-        float last = fail ? sdf_inf() : s;
-        t = stop ? t : tn;
-        if (stop || past) {
-            float path = t0 + t;
-            return last < sdf_thr(path) || (steps >= SDF_MAX_STEPS && last < sdf_footprint(path));
-        }
-    }
-    return false;
+// unbounding spheres stop overlapping) on the signed value s at t. A hit is s < epsilon *
+// max(path, 1), or, out of steps, s within one pixel footprint. `strict`: shadow rays end
+// at t >= tmax (camera and bounce rays at t > tmax).
+bool sdf_relaxed_step(float s, float t0, float tmax, bool strict, int steps, inout float t, inout float om, inout float pr,
+                      inout float sl, out bool hit) {
+    float r = abs(s);
+    bool fail = om > 1.0 && r + pr < sl;
+    float step = fail ? (1.0 - om) * sl : om * s;
+    om = fail ? 1.0 : om;
+    sl = step;
+    pr = r;
+    bool stop = (s < SDF_EPSILON * max(t0 + t, 1.0) && !fail) || steps >= SDF_MAX_STEPS;
+    float tn = t + step;
+    bool past = strict ? !(tn < tmax) : !(tn <= tmax);
+    float last = fail ? sdf_inf() : s;
+    t = stop ? t : tn;
+    float path = t0 + t;
+    hit = last < sdf_thr(path) || (steps >= SDF_MAX_STEPS && last < sdf_footprint(path));
+    return stop || past;
 }
 
-// Cone tracing of a primary ray (render(aa = "cone")): up to 4 partial hits at edges.
-bool sdf_cone_march(vec3 o, vec3 d, float tmin, float tmax, out float t, out float ev_t[4], out float ev_w[4],
-                    out int ev_n, out float trans) {
-    ev_n = 0;
-    trans = 1.0;
-    for (int e = 0; e < 4; ++e) { ev_t[e] = 0.0; ev_w[e] = 0.0; }
-    t = tmin;
-    if (!(t <= tmax)) { t = tmax; return false; }
-    float a = 2.0, b = 0.0;
-    for (int steps = 1; steps <= SDF_MAX_STEPS; ++steps) {
-        float dist = map(o + t * d);
-        float path = t;
-        float radius = max(sdf_footprint(path), 1e-30);
-        if (dist < sdf_thr(path)) return true;
-        if (isnan(dist)) return false;
-        bool done = false, hit = false;
-        float rho = dist / radius;
-        if (rho < 1.0) {
-            if (rho < a) { a = rho; b = t; }
-        } else if (a < 1.0) {
-            float cov = 1.0 - a;
-            if (ev_n < 4 && cov > 0.0) { ev_t[ev_n] = b; ev_w[ev_n] = trans * cov; trans *= 1.0 - cov; ++ev_n; }
-            a = 2.0;
-        }
-        if (trans < 1e-3) {
-            done = true;
-        } else if (steps >= SDF_MAX_STEPS) {
-            done = true;
-            hit = dist < radius;
+// Raw fields (.vm models, no distance bound): steps of |f| / L (L a Lipschitz estimate made by
+// the compiler as the CPU renderer makes it), clamped to [one pixel footprint, SDF_RAW_MAX_STEP];
+// a sign change is refined by bisection to the outside end of the bracket [lo, hi]. `shadow`:
+// any sign change is a hit.
+bool sdf_raw_step(float s, float t0, float tmax, bool shadow, int steps, inout float t, inout float prev, inout float lo,
+                  inout float hi, inout float bisect, out bool hit) {
+    float path = t0 + t;
+    bool done = false;
+    hit = false;
+    if (bisect > 0.0) {
+        if (s < 0.0) hi = t;
+        else lo = t;
+        bisect += 1.0;
+        if (bisect > 12.0 || hi - lo < sdf_thr(path)) {
+            t = lo;
+            done = hit = true;
         } else {
-            t += dist;
-            if (!(t <= tmax)) done = true;
+            t = 0.5 * (lo + hi);
         }
-        if (done && !hit && a < 1.0) {
-            float cov = 1.0 - a;
-            if (ev_n < 4 && cov > 0.0) { ev_t[ev_n] = b; ev_w[ev_n] = trans * cov; trans *= 1.0 - cov; ++ev_n; }
+    } else if (s <= 0.0) {
+        if (s == 0.0 || prev < 0.0 || shadow) {
+            done = hit = true;
+        } else {
+            lo = prev;
+            hi = t;
+            bisect = 1.0;
+            t = 0.5 * (lo + hi);
         }
-        if (done) return hit;
+    } else {
+        float fp = sdf_footprint(path), step = fp;
+        if (!isnan(s)) {
+            float v = s * SDF_RAW_INV_LIPSCHITZ;
+            step = v < fp ? fp : (SDF_RAW_MAX_STEP < v ? SDF_RAW_MAX_STEP : v);
+        }
+        prev = t;
+        t = t + step;
+        done = !(t <= tmax);
     }
-    return false;
+    if (!done && steps >= SDF_MAX_STEPS) {
+        done = true;
+        hit = bisect > 0.0;
+        if (hit) t = lo;
+    }
+    return done;
 }
 
-// Tetrahedron normal; a flat or broken field faces the viewer.
-vec3 sdf_normal(vec3 p, float path, vec3 dir) {
-    float e = max(sdf_thr(path), 2e-5 * (1.0 + sdf_maxabs3(p)));
-    vec3 g = vec3(0.0);
-    for (int k = 0; k < 4; ++k) {
-        vec3 kk = k == 0 ? vec3(1.0, -1.0, -1.0) : (k == 1 ? vec3(-1.0, -1.0, 1.0) : (k == 2 ? vec3(-1.0, 1.0, -1.0) : vec3(1.0)));
-        g += kk * map(p + e * kk);
-    }
-    float len2 = dot(g, g);
-    if (len2 > 1e-30 && sdf_finite(len2)) return g * (1.0 / sqrt(len2));
-    return -dir;
+// Soft shadows: Quilez's penumbra estimate with the closest-approach refinement (h and the
+// previous positive h), marching through occluders; res is the smallest cone fraction.
+bool sdf_soft_step(float h, float t0, float tmax, float w, int steps, inout float t, inout float res, inout float prev) {
+    float thr = SDF_EPSILON * max(t0 + t, 1.0);
+    bool pos = h > 0.0;
+    float y = min(h * h / (2.0 * prev), 0.999 * h);
+    float dd = sqrt(max(h * h - y * y, 0.0));
+    float est = pos ? dd / (w * max(t - y, 1e-20)) : h / (w * max(t, 1e-20));
+    res = est < res ? est : res;  // NaN keeps res
+    prev = pos ? h : 1e20;
+    float step = pos ? max(h, thr) : max(0.25 * w * t, thr);
+    t = t + step;
+    return isnan(h) || res <= -1.0 || steps >= SDF_MAX_STEPS || !(t < tmax);
+}
+
+float sdf_penumbra(float res) {
+    res = clamp(res, -1.0, 1.0);
+    return 0.25 * (1.0 + res) * (1.0 + res) * (2.0 - res);
+}
+
+// Tetrahedron technique: the normal is sum_k k * map(p + e * k).
+vec3 sdf_tetra(int k) {
+    return k == 0 ? vec3(1.0, -1.0, -1.0) : (k == 1 ? vec3(-1.0, -1.0, 1.0) : (k == 2 ? vec3(-1.0, 1.0, -1.0) : vec3(1.0)));
 }
 
 // The material at p, sanitised (no NaN/inf, sensible ranges).
@@ -313,110 +278,9 @@ float sdf_schlick(float cos_theta, float ior) {
     return r0 + (1.0 - r0) * m2 * m2 * m;
 }
 
-float sdf_penumbra(float res) {
-    res = clamp(res, -1.0, 1.0);
-    return 0.25 * (1.0 + res) * (1.0 + res) * (2.0 - res);
-}
-
-// Visibility of a light along [tmin, tmax]: hard (any hit = 0; over-relaxed like
-// sdf_march), or, with a light radius (angular width w), Quilez's soft penumbra with the
-// closest-approach refinement, marching through occluders.
-float sdf_shadow(vec3 o, vec3 l, float tmin, float tmax, float t0, float w, bool soft) {
-    float t = tmin;
-    if (!(t <= tmax)) return 1.0;
-    if (SDF_RAW) return sdf_march_raw(o, l, tmin, tmax, t0, false, true, t) ? 0.0 : 1.0;
-    float om = SDF_RELAX, pr = 0.0, sl = 0.0;  // hard
-    float res = 1.0, prev = 1e20;              // soft
-    for (int steps = 1; steps <= SDF_MAX_STEPS; ++steps) {
-        float h = map(o + t * l);
-        float thr = SDF_EPSILON * max(t0 + t, 1.0);
-        if (!soft) {
-            float r = abs(h);
-            bool fail = om > 1.0 && r + pr < sl;
-            float step = fail ? (1.0 - om) * sl : om * h;
-            om = fail ? 1.0 : om;
-            sl = step;
-            pr = r;
-            bool stop = (h < thr && !fail) || steps >= SDF_MAX_STEPS;
-            float tn = t + step;
-            bool past = !(tn < tmax);
-            float last = fail ? sdf_inf() : h;
-            t = stop ? t : tn;
-            if (stop || past) {
-                float path = t0 + t;
-                return (last < sdf_thr(path) || (steps >= SDF_MAX_STEPS && last < sdf_footprint(path))) ? 0.0 : 1.0;
-            }
-        } else {
-            bool pos = h > 0.0;
-            float y = min(h * h / (2.0 * prev), 0.999 * h);
-            float dd = sqrt(max(h * h - y * y, 0.0));
-            float est = pos ? dd / (w * max(t - y, 1e-20)) : h / (w * max(t, 1e-20));
-            res = est < res ? est : res;  // NaN keeps res
-            prev = pos ? h : 1e20;
-            float step = pos ? max(h, thr) : max(0.25 * w * t, thr);
-            float tn = t + step;
-            t = tn;
-            if (isnan(h) || res <= -1.0 || steps >= SDF_MAX_STEPS || !(tn < tmax)) return sdf_penumbra(res);
-        }
-    }
-    return 1.0;
-}
-
 float sdf_pow(float x, float y) {
     if (y == 0.0) return 1.0;
     return x > 0.0 ? pow(x, y) : 0.0;
-}
-
-// Ambient (with occlusion) and direct light at a surface point of local weight lw.
-vec3 sdf_local_light(vec3 P, vec3 D, vec3 N, float path, Material m, vec3 lw) {
-    vec3 acc = vec3(0.0);
-    if (sdf_max3(sdf_ambient) > 0.0) {
-        float ao = 1.0;
-        if (SDF_AO) {
-            float occ = 0.0, sca = 1.0;
-            for (int j = 0; j < 5; ++j) {
-                float s = 0.01 + 0.12 * float(j) / 4.0;
-                float d = map(P + N * s);
-                if (d < s) occ += (s - d) * sca;  // (NaN adds nothing)
-                sca *= 0.95;
-            }
-            ao = sdf_clamp01(1.0 - 3.0 * occ);
-        }
-        acc += lw * m.color * sdf_ambient * ao;
-    }
-    for (int i = 0; i < SDF_NUM_LIGHTS; ++i) {
-        SdfLight li = sdf_lights[i];
-        vec3 radiance = li.color * li.intensity;
-        float rmax = sdf_max3(radiance);
-        if (!(rmax > 0.0) || !sdf_finite(rmax)) continue;
-        vec3 L = -li.direction;
-        float dist = SDF_MAX_DIST, falloff = 1.0;
-        if (li.directional) {
-            if (!(dot(L, L) > 0.0)) continue;
-            L = normalize(L);
-        } else {
-            L = li.position - P;
-            dist = length(L);
-            if (!(dist > 1e-6)) continue;
-            L /= dist;
-            falloff = 1.0 / (dist * dist);
-        }
-        float ndl = dot(N, L);
-        if (!(ndl > 0.0)) continue;
-        vec3 H = normalize(L - D);
-        float ndh = max(dot(N, H), 0.0);
-        float spec = m.specular > 0.0 ? m.specular * sdf_pow(ndh, m.shininess) : 0.0;
-        vec3 c = lw * radiance * falloff * (m.color * ndl + spec);
-        if (!SDF_SHADOWS) { acc += c; continue; }
-        float bias = sdf_bias(P, path);
-        vec3 o = P + N * bias;
-        float tmin = 0.0, tmax = li.directional ? SDF_MAX_DIST : max(dist - bias, 0.0);
-        sdf_clip_ray(o, L, tmin, tmax);
-        if (!(tmin <= tmax)) { acc += c; continue; }
-        float vis = sdf_shadow(o, L, tmin, tmax, path, li.directional ? li.radius : li.radius / dist, li.radius > 0.0);
-        if (vis > 0.0) acc += c * vis;
-    }
-    return acc;
 }
 
 // Settings the CPU compiler resolves (compiler/compile.cpp): light directions normalised,
@@ -442,92 +306,305 @@ struct SdfRay {
 };
 const int SDF_STACK = SDF_MAX_BOUNCES + 6;
 
-// One primary sample of weight w0: the first hit, then mirror/glass bounces depth first. (The
-// primary ray goes through the same stack as the bounces, so map() is inlined at one marching
-// call site.)
+// What sdf_trace is doing: the states that evaluate the distance once per loop turn...
+const int SDF_ST_MARCH = 0;   // a camera / bounce ray
+const int SDF_ST_CONE = 1;    // the cone of a primary ray (aa = "cone")
+const int SDF_ST_NORMAL = 2;  // the 4 taps of a hit's normal
+const int SDF_ST_AO = 3;      // the 5 ambient-occlusion taps
+const int SDF_ST_SHADOW = 4;  // a shadow ray toward light `li`
+// ... and those that do not.
+const int SDF_ST_POP = 5;     // next ray from the stack
+const int SDF_ST_LIGHT = 6;   // set up light `li`
+const int SDF_ST_DONE = 7;
+
+// One primary sample of weight w0: the first hit, then mirror/glass bounces depth first from
+// an explicit stack (GLSL has no recursion). Everything the CPU does per ray (marching,
+// normals, AO, shadow rays) is one state machine around a single map() call, so shader
+// compilers inline the scene once instead of once per use (and never unroll it).
 vec3 sdf_trace(vec3 O, vec3 D, float w0) {
     vec3 acc = vec3(0.0);
     SdfRay stack[SDF_STACK];
     int sp = 0;
     float tmin = 0.0, tmax = SDF_MAX_DIST;
     sdf_clip_ray(O, D, tmin, tmax);
-    float t = 0.0;
+    SdfRay r = SdfRay(O, D, vec3(w0), tmin, tmax, 0.0, 0.0, false, false, 0);
+    int mode = SDF_ST_POP;
+    // Marching state (camera, bounce, cone and shadow rays).
+    float t = 0.0, om = SDF_RELAX, pr = 0.0, sl = 0.0, prev = -1.0, lo = 0.0, hi = 0.0, bisect = 0.0;
+    int steps = 0;
+    // Cone state: the closest approach (a, at b) of the current edge zone, the partial hits.
+    float ca = 2.0, cb = 0.0, trans = 1.0;
+    float ev_t[4], ev_w[4];
+    int ev_n = 0;
+    // The surface being shaded.
+    vec3 P = vec3(0.0), Dr = D, Nf = vec3(0.0), g = vec3(0.0), lw = vec3(0.0);
+    float path = 0.0, e = 0.0, occ = 0.0, sca = 1.0;
+    int k = 0;
+    Material m = Material(vec3(0.0), 0.0, 0.0, 0.0, 0.0, 1.0, vec3(0.0));
+    // The shadow ray of light li.
+    int li = 0;
+    vec3 so = vec3(0.0), sdir = vec3(0.0), sc = vec3(0.0);
+    float stmax = 0.0, sw = 0.0, res = 1.0;
+    bool soft = false;
+    for (int q = 0; q < 4; ++q) { ev_t[q] = 0.0; ev_w[q] = 0.0; }
     if (SDF_CONE) {
-        float ev_t[4], ev_w[4], trans;
-        int ev_n;
-        bool hit = sdf_cone_march(O, D, tmin, tmax, t, ev_t, ev_w, ev_n, trans);
-        for (int e = 0; e < 4; ++e)
-            if (e < ev_n) stack[sp++] = SdfRay(O, D, vec3(ev_w[e] * w0), 0.0, 0.0, 0.0, ev_t[e], false, true, 0);
-        float rest = trans * w0;
-        if (hit) stack[sp++] = SdfRay(O, D, vec3(rest), 0.0, 0.0, 0.0, t, false, true, 0);
-        else acc += sdf_background * rest;
+        mode = SDF_ST_CONE;
+        t = tmin;
+        if (!(t <= tmax)) {  // misses the scene's box
+            acc += sdf_background * w0;
+            mode = SDF_ST_DONE;
+        }
     } else {
-        stack[sp++] = SdfRay(O, D, vec3(w0), tmin, tmax, 0.0, 0.0, false, false, 0);  // marched below
+        stack[sp++] = r;
     }
-    for (int guard = 0; guard < 4096 && sp > 0; ++guard) {
-        SdfRay r = stack[--sp];
-        t = r.thit;
-        if (!r.known) {
-            if (!sdf_march(r.o, r.d, r.tmin, r.tmax, r.t0, r.inside, t)) {
-                if (!r.inside) acc += sdf_background * r.w;
+
+    for (int turn = sdf_zero; turn < 16777216; ++turn) {
+        // Transitions that need no distance.
+        for (int guard = sdf_zero; guard < 4 * SDF_STACK + SDF_NUM_LIGHTS + 8; ++guard) {
+            if (mode == SDF_ST_POP) {
+                if (sp == 0) {
+                    mode = SDF_ST_DONE;
+                    break;
+                }
+                r = stack[--sp];
+                if (r.known) {
+                    t = r.thit;
+                    mode = SDF_ST_NORMAL;
+                } else {
+                    t = r.tmin;
+                    if (!(t <= r.tmax)) {  // misses the scene's box
+                        if (!r.inside) acc += sdf_background * r.w;
+                        continue;
+                    }
+                    om = SDF_RELAX, pr = 0.0, sl = 0.0, prev = -1.0, lo = 0.0, hi = 0.0, bisect = 0.0;
+                    steps = 0;
+                    mode = SDF_ST_MARCH;
+                    break;
+                }
+            }
+            if (mode == SDF_ST_NORMAL && k == 0) {
+                // A hit: set up the normal's taps.
+                P = r.o + r.d * t;
+                path = r.t0 + t;
+                Dr = r.d;
+                e = max(sdf_thr(path), 2e-5 * (1.0 + sdf_maxabs3(P)));
+                g = vec3(0.0);
+                break;
+            }
+            if (mode == SDF_ST_LIGHT) {
+                if (li >= SDF_NUM_LIGHTS) {
+                    mode = SDF_ST_POP;
+                    continue;
+                }
+                SdfLight light = sdf_lights[li];
+                vec3 radiance = light.color * light.intensity;
+                float rmax = sdf_max3(radiance);
+                vec3 L = -light.direction;
+                float dist = SDF_MAX_DIST, falloff = 1.0;
+                bool skip = !(rmax > 0.0) || !sdf_finite(rmax);
+                if (!skip && light.directional) {
+                    skip = !(dot(L, L) > 0.0);
+                    if (!skip) L = normalize(L);
+                } else if (!skip) {
+                    L = light.position - P;
+                    dist = length(L);
+                    skip = !(dist > 1e-6);
+                    L /= dist;
+                    falloff = 1.0 / (dist * dist);
+                }
+                float ndl = dot(Nf, L);
+                if (skip || !(ndl > 0.0)) {
+                    ++li;
+                    continue;
+                }
+                vec3 H = normalize(L - Dr);
+                float ndh = max(dot(Nf, H), 0.0);
+                float spec = m.specular > 0.0 ? m.specular * sdf_pow(ndh, m.shininess) : 0.0;
+                sc = lw * radiance * falloff * (m.color * ndl + spec);
+                if (!SDF_SHADOWS) {
+                    acc += sc;
+                    ++li;
+                    continue;
+                }
+                float bias = sdf_bias(P, path);
+                so = P + Nf * bias;
+                sdir = L;
+                float a0 = 0.0;
+                stmax = light.directional ? SDF_MAX_DIST : max(dist - bias, 0.0);
+                sdf_clip_ray(so, sdir, a0, stmax);
+                if (!(a0 <= stmax)) {  // the segment never enters the scene's box
+                    acc += sc;
+                    ++li;
+                    continue;
+                }
+                t = a0;
+                sw = light.directional ? light.radius : light.radius / dist;
+                soft = light.radius > 0.0 && !SDF_RAW;
+                om = SDF_RELAX, pr = 0.0, sl = 0.0, res = 1.0, prev = SDF_RAW ? -1.0 : 1e20, lo = 0.0, hi = 0.0, bisect = 0.0;
+                steps = 0;
+                mode = SDF_ST_SHADOW;
+                break;
+            }
+            break;
+        }
+        if (mode == SDF_ST_DONE) break;
+        if (mode >= SDF_ST_POP) continue;  // (not reached: the loop above always gets to a state that evaluates)
+
+        // The distance, once per turn.
+        vec3 pos = mode == SDF_ST_MARCH ? r.o + t * r.d
+                 : mode == SDF_ST_CONE ? O + t * D
+                 : mode == SDF_ST_NORMAL ? P + e * sdf_tetra(k)
+                 : mode == SDF_ST_AO ? P + Nf * (0.01 + 0.12 * float(k) / 4.0)
+                 : so + t * sdir;
+        float dist = map(pos);
+        ++steps;
+
+        if (mode == SDF_ST_MARCH) {
+            bool hit;
+            bool done = SDF_RAW ? sdf_raw_step(r.inside ? -dist : dist, r.t0, r.tmax, false, steps, t, prev, lo, hi, bisect, hit)
+                                : sdf_relaxed_step(r.inside ? -dist : dist, r.t0, r.tmax, false, steps, t, om, pr, sl, hit);
+            if (done) {
+                if (hit) {
+                    mode = SDF_ST_NORMAL;
+                    k = 0;
+                } else {
+                    if (!r.inside) acc += sdf_background * r.w;
+                    mode = SDF_ST_POP;
+                }
+            }
+        } else if (mode == SDF_ST_CONE) {
+            // Cone tracing (primary rays only): where the ray passes an edge (d < the pixel
+            // footprint without hitting) the closest approach is a partial hit of coverage
+            // 1 - d/r; up to 4 are composited front to back, the final hit takes the rest.
+            float radius = max(sdf_footprint(t), 1e-30);
+            bool done = false, hit = false;
+            if (dist < sdf_thr(t)) {
+                done = hit = true;
+            } else if (isnan(dist)) {
+                done = true;
+            } else {
+                float rho = dist / radius;
+                if (rho < 1.0) {
+                    if (rho < ca) { ca = rho; cb = t; }
+                } else if (ca < 1.0) {
+                    float cov = 1.0 - ca;
+                    if (ev_n < 4 && cov > 0.0) { ev_t[ev_n] = cb; ev_w[ev_n] = trans * cov; trans *= 1.0 - cov; ++ev_n; }
+                    ca = 2.0;
+                }
+                if (trans < 1e-3) {
+                    done = true;
+                } else if (steps >= SDF_MAX_STEPS) {
+                    done = true;
+                    hit = dist < radius;
+                } else {
+                    t += dist;
+                    done = !(t <= tmax);
+                }
+                if (done && !hit && ca < 1.0) {
+                    float cov = 1.0 - ca;
+                    if (ev_n < 4 && cov > 0.0) { ev_t[ev_n] = cb; ev_w[ev_n] = trans * cov; trans *= 1.0 - cov; ++ev_n; }
+                }
+            }
+            if (done) {
+                for (int q = 0; q < 4; ++q)
+                    if (q < ev_n) stack[sp++] = SdfRay(O, D, vec3(ev_w[q] * w0), 0.0, 0.0, 0.0, ev_t[q], false, true, 0);
+                float rest = trans * w0;
+                if (hit) stack[sp++] = SdfRay(O, D, vec3(rest), 0.0, 0.0, 0.0, t, false, true, 0);
+                else acc += sdf_background * rest;
+                mode = SDF_ST_POP;
+                k = 0;
+            }
+        } else if (mode == SDF_ST_NORMAL) {
+            g += sdf_tetra(k) * dist;
+            if (++k < 4) continue;
+            k = 0;
+            float len2 = dot(g, g);
+            vec3 N = (len2 > 1e-30 && sdf_finite(len2)) ? g * (1.0 / sqrt(len2)) : -Dr;  // flat or broken: face the viewer
+            Nf = dot(Dr, N) > 0.0 ? -N : N;  // facing the incoming ray
+            m = sdf_surface(P);
+            bool can_spawn = r.gen < SDF_MAX_BOUNCES;
+            float bias = sdf_bias(P, path);
+            mode = SDF_ST_POP;
+            if (r.inside) {
+                // Leaving a transparent solid: refract out, reflect back in (Fresnel / TIR).
+                if (!can_spawn) continue;
+                vec3 T = refract(Dr, Nf, m.ior);
+                float F = 1.0;
+                if (dot(T, T) > 0.0) F = sdf_schlick(-dot(T, Nf), m.ior);
+                vec3 wr = r.w * F, wt = r.w * (1.0 - F);
+                if (sdf_max3(wr) >= SDF_MIN_WEIGHT && sp < SDF_STACK) {
+                    vec3 o = P + Nf * bias, d = reflect(Dr, Nf);
+                    float a0 = 0.0, b0 = SDF_MAX_DIST;
+                    sdf_clip_ray(o, d, a0, b0);
+                    stack[sp++] = SdfRay(o, d, wr, a0, b0, path, 0.0, true, false, r.gen + 1);
+                }
+                if (sdf_max3(wt) >= SDF_MIN_WEIGHT && sp < SDF_STACK) {
+                    vec3 o = P - Nf * bias, d = normalize(T);
+                    float a0 = 0.0, b0 = SDF_MAX_DIST;
+                    sdf_clip_ray(o, d, a0, b0);
+                    stack[sp++] = SdfRay(o, d, wt, a0, b0, path, 0.0, false, false, r.gen + 1);
+                }
                 continue;
             }
-        }
-        vec3 P = r.o + r.d * t;
-        float path = r.t0 + t;
-        vec3 Dr = r.d;
-        vec3 N = sdf_normal(P, path, Dr);
-        vec3 Nf = dot(Dr, N) > 0.0 ? -N : N;
-        Material m = sdf_surface(P);
-        bool can_spawn = r.gen < SDF_MAX_BOUNCES;
-        float bias = sdf_bias(P, path);
-        if (r.inside) {
-            // Leaving a transparent solid: refract out, reflect back in (Fresnel / TIR).
-            if (!can_spawn) continue;
-            vec3 T = refract(Dr, Nf, m.ior);
-            float F = 1.0;
-            if (dot(T, T) > 0.0) F = sdf_schlick(-dot(T, Nf), m.ior);
-            vec3 wr = r.w * F, wt = r.w * (1.0 - F);
-            if (sdf_max3(wr) >= SDF_MIN_WEIGHT && sp < SDF_STACK) {
-                vec3 o = P + Nf * bias, d = reflect(Dr, Nf);
-                float a = 0.0, b = SDF_MAX_DIST;
-                sdf_clip_ray(o, d, a, b);
-                stack[sp++] = SdfRay(o, d, wr, a, b, path, 0.0, true, false, r.gen + 1);
+            acc += r.w * m.emission;
+            float refl = can_spawn ? m.reflectance : 0.0;
+            float tr = can_spawn ? m.transparency : 0.0;
+            lw = r.w * ((1.0 - refl) * (1.0 - tr));
+            if (can_spawn) {
+                vec3 w_refl = r.w * refl;
+                if (tr > 0.0) {
+                    vec3 base = r.w * ((1.0 - refl) * tr);
+                    vec3 T = refract(Dr, Nf, 1.0 / m.ior);
+                    float F = 1.0;
+                    if (dot(T, T) > 0.0) F = sdf_schlick(-dot(Dr, Nf), m.ior);
+                    w_refl += base * F;
+                    vec3 wt = base * (1.0 - F) * m.color;  // tinted glass
+                    if (sdf_max3(wt) >= SDF_MIN_WEIGHT && sp < SDF_STACK) {
+                        vec3 o = P - Nf * bias, d = normalize(T);
+                        float a0 = 0.0, b0 = SDF_MAX_DIST;
+                        sdf_clip_ray(o, d, a0, b0);
+                        stack[sp++] = SdfRay(o, d, wt, a0, b0, path, 0.0, true, false, r.gen + 1);
+                    }
+                }
+                if (sdf_max3(w_refl) >= SDF_MIN_WEIGHT && sp < SDF_STACK) {
+                    vec3 o = P + Nf * bias, d = reflect(Dr, Nf);
+                    float a0 = 0.0, b0 = SDF_MAX_DIST;
+                    sdf_clip_ray(o, d, a0, b0);
+                    stack[sp++] = SdfRay(o, d, w_refl, a0, b0, path, 0.0, false, false, r.gen + 1);
+                }
             }
-            if (sdf_max3(wt) >= SDF_MIN_WEIGHT && sp < SDF_STACK) {
-                vec3 o = P - Nf * bias, d = normalize(T);
-                float a = 0.0, b = SDF_MAX_DIST;
-                sdf_clip_ray(o, d, a, b);
-                stack[sp++] = SdfRay(o, d, wt, a, b, path, 0.0, false, false, r.gen + 1);
+            if (!(sdf_max3(lw) > 0.0)) continue;
+            // Local shading: ambient (with occlusion), then the lights.
+            li = 0;
+            mode = SDF_ST_LIGHT;
+            if (sdf_max3(sdf_ambient) > 0.0) {
+                if (SDF_AO) {
+                    mode = SDF_ST_AO;
+                    occ = 0.0;
+                    sca = 1.0;
+                } else {
+                    acc += lw * m.color * sdf_ambient;
+                }
             }
-            continue;
-        }
-        acc += r.w * m.emission;
-        float refl = can_spawn ? m.reflectance : 0.0;
-        float tr = can_spawn ? m.transparency : 0.0;
-        vec3 lw = r.w * ((1.0 - refl) * (1.0 - tr));
-        if (sdf_max3(lw) > 0.0) acc += sdf_local_light(P, Dr, Nf, path, m, lw);
-        if (!can_spawn) continue;
-        vec3 w_refl = r.w * refl;
-        if (tr > 0.0) {
-            vec3 base = r.w * ((1.0 - refl) * tr);
-            vec3 T = refract(Dr, Nf, 1.0 / m.ior);
-            float F = 1.0;
-            if (dot(T, T) > 0.0) F = sdf_schlick(-dot(Dr, Nf), m.ior);
-            w_refl += base * F;
-            vec3 wt = base * (1.0 - F) * m.color;
-            if (sdf_max3(wt) >= SDF_MIN_WEIGHT && sp < SDF_STACK) {
-                vec3 o = P - Nf * bias, d = normalize(T);
-                float a = 0.0, b = SDF_MAX_DIST;
-                sdf_clip_ray(o, d, a, b);
-                stack[sp++] = SdfRay(o, d, wt, a, b, path, 0.0, true, false, r.gen + 1);
+        } else if (mode == SDF_ST_AO) {
+            float s = 0.01 + 0.12 * float(k) / 4.0;
+            if (dist < s) occ += (s - dist) * sca;  // (NaN adds nothing)
+            sca *= 0.95;
+            if (++k < 5) continue;
+            k = 0;
+            acc += lw * m.color * sdf_ambient * sdf_clamp01(1.0 - 3.0 * occ);
+            mode = SDF_ST_LIGHT;
+        } else {  // SDF_ST_SHADOW
+            bool hit = false, done;
+            if (SDF_RAW) done = sdf_raw_step(dist, path, stmax, true, steps, t, prev, lo, hi, bisect, hit);
+            else if (soft) done = sdf_soft_step(dist, path, stmax, sw, steps, t, res, prev);
+            else done = sdf_relaxed_step(dist, path, stmax, true, steps, t, om, pr, sl, hit);
+            if (done) {
+                float vis = soft ? sdf_penumbra(res) : (hit ? 0.0 : 1.0);
+                if (vis > 0.0) acc += sc * vis;
+                ++li;
+                mode = SDF_ST_LIGHT;
             }
-        }
-        if (sdf_max3(w_refl) >= SDF_MIN_WEIGHT && sp < SDF_STACK) {
-            vec3 o = P + Nf * bias, d = reflect(Dr, Nf);
-            float a = 0.0, b = SDF_MAX_DIST;
-            sdf_clip_ray(o, d, a, b);
-            stack[sp++] = SdfRay(o, d, w_refl, a, b, path, 0.0, false, false, r.gen + 1);
         }
     }
     return acc;
@@ -543,6 +620,7 @@ float sdf_to_srgb(float v) {
 // viewport at `time`, with an optional interactive orbit (see sdf_orbit).
 vec4 sdf_render(vec2 frag_coord, vec2 res, float time, vec4 orbit, vec2 pan) {
     sdf_time = time;
+    sdf_zero = int(min(res.x, 0.0));
     sdf_settings();
     sdf_init_scene();
     float x = floor(frag_coord.x), row = floor(res.y) - 1.0 - floor(frag_coord.y);
@@ -557,7 +635,7 @@ vec4 sdf_render(vec2 frag_coord, vec2 res, float time, vec4 orbit, vec2 pan) {
     if (orbit.w > 0.0) sdf_orbit(pos, target, sdf_cam_up, orbit, pan);
     sdf_setup_camera(pos, target, sdf_cam_up, sdf_cam_fov, sdf_cam_ortho_height, floor(res));
     vec3 acc = vec3(0.0);
-    for (int s = 0; s < SDF_SAMPLES; ++s) {
+    for (int s = sdf_zero; s < SDF_SAMPLES; ++s) {
         vec3 o, d;
         sdf_camera_ray(x + SDF_OFFSETS[s].x, row + SDF_OFFSETS[s].y, o, d);
         acc += sdf_trace(o, d, SDF_SAMPLE_WEIGHT);

@@ -72,6 +72,24 @@ float bound_radius(const Bounds& b) {
 }
 
 Lowered lower_primitive(L& l, const Shape& s, const Vec3N& p);
+
+// Twist and bend multiply the Lipschitz bound by sqrt(1 + (wR)^2) (+ wR for bend), w the
+// rate in radians per unit, R the child's radius. Constant w: folded into lip; otherwise
+// the distance is divided by the bound as an expression.
+Lowered distort_bound(L& l, Lowered r, NodeId w, float R, bool bend) {
+    Graph& g = l.g;
+    if (g.is_const(w)) {
+        float wr = std::fabs(g.const_value(w)) * R;
+        r.lip *= std::sqrt(1.0f + wr * wr) + (bend ? wr : 0.0f);
+        return r;
+    }
+    NodeId wr = l.mul(l.abs(w), l.c(R));
+    NodeId k = l.sqrt(l.add(l.c(1.0f), l.mul(wr, wr)));
+    if (bend) k = l.add(k, wr);
+    r.d = l.div(unit(g, r), k);
+    r.lip = 1.0f;
+    return r;
+}
 Lowered lower_csg(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited);
 
 }  // namespace
@@ -224,10 +242,9 @@ Lowered lower_shape(Graph& g, const Shape& s, const Vec3N& p, const MaterialN* i
             NodeId a = l.mul(w, p[1]);
             NodeId cs = g.unary(Op::Cos, a), sn = g.unary(Op::Sin, a);
             Lowered r = child({l.sub(l.mul(cs, p[0]), l.mul(sn, p[2])), p[1], l.add(l.mul(sn, p[0]), l.mul(cs, p[2]))});
-            // |J| <= sqrt(1 + (w R)^2) with R the child's radius about the axis.
-            float wr = g.is_const(w) ? std::fabs(g.const_value(w)) * bound_radius(shape_bounds(g, *s.children[0])) : 0.0f;
-            r.lip *= std::sqrt(1.0f + wr * wr);
-            out = r;
+            // |J| <= sqrt(1 + (w R)^2) with R the child's radius about the axis. A rate that
+            // depends on time (GLSL) divides by the same bound computed at run time.
+            out = distort_bound(l, r, w, bound_radius(shape_bounds(g, *s.children[0])), false);
             break;
         }
         case ShapeKind::Bend: {
@@ -235,9 +252,7 @@ Lowered lower_shape(Graph& g, const Shape& s, const Vec3N& p, const MaterialN* i
             NodeId a = l.mul(w, p[0]);
             NodeId cs = g.unary(Op::Cos, a), sn = g.unary(Op::Sin, a);
             Lowered r = child({l.sub(l.mul(cs, p[0]), l.mul(sn, p[1])), l.add(l.mul(sn, p[0]), l.mul(cs, p[1])), p[2]});
-            float wr = g.is_const(w) ? std::fabs(g.const_value(w)) * bound_radius(shape_bounds(g, *s.children[0])) : 0.0f;
-            r.lip *= std::sqrt(1.0f + wr * wr) + wr;
-            out = r;
+            out = distort_bound(l, r, w, bound_radius(shape_bounds(g, *s.children[0])), true);
             break;
         }
         case ShapeKind::Round: {

@@ -235,7 +235,7 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
         case ast::StmtKind::Import: {
             namespace fs = std::filesystem;
             fs::path base = fs::path(s.loc.file->path).parent_path();
-            fs::path target = base / s.name;
+            fs::path target = (base / s.name).lexically_normal();  // as diagnostics show it
             std::string key = fs::weakly_canonical(target).string();
             if (std::find(import_stack.begin(), import_stack.end(), key) != import_stack.end()) {
                 std::string chain;
@@ -248,19 +248,24 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
                 defs = found->second;
             } else {
                 const SourceFile& f = sm.load(target.string(), s.loc, opts.limits.max_file_bytes);
+                // Registered before it runs: each file is read once, and an error in it is
+                // reported once (a later import gets what was defined before the error).
+                defs = new_env(nullptr);
+                imported[key] = defs;
+                pin_envs();
                 modules.push_back(ast::parse(f, ast::ParseOptions{opts.limits.max_nesting}));
                 const ast::Module& m = *modules.back();
-                defs = new_env(nullptr);
                 import_stack.push_back(key);
+                struct Pop {  // also when the import fails: the run goes on with the next statement
+                    std::vector<std::string>& stack;
+                    ~Pop() { stack.pop_back(); }
+                } pop{import_stack};
                 std::vector<ShapePtr> ignored;
                 // Only definitions travel: defs and lets (and the imports they need).
                 for (const auto& st : m.stmts)
                     if (st->kind == ast::StmtKind::Def) exec(*st, defs, ignored);
                 for (const auto& st : m.stmts)
                     if (st->kind == ast::StmtKind::Let || st->kind == ast::StmtKind::Import) exec(*st, defs, ignored);
-                import_stack.pop_back();
-                imported[key] = defs;
-                pin_envs();
             }
             for (const auto& [name, b] : defs->vars)
                 if (!env->vars.count(name)) env->vars[name] = b;
@@ -690,7 +695,8 @@ Value Interp::apply(const ast::Expr& e, Env* env) {
         m.mod = mv;
     }
     if (m.t != VT::Modifier)
-        fail(e.lhs->loc, fmt::format("{} is written before a shape but is not an operation", describe(m)));
+        fail(e.lhs->loc, fmt::format("{} is written before a shape but is not an operation{}", describe(m),
+                                     m.t == VT::Shape ? " (is a ';' missing after it?)" : ""));
     Value t = eval(*e.rhs, env);
     ShapePtr target = to_shape(t, e.rhs->loc, fmt::format("the target of {}", m.mod->name).c_str());
     return Value::of_shape(apply_modifier(*m.mod, target, e.loc));

@@ -17,7 +17,7 @@ struct Limits {
     long max_total_iterations = 10000000; // all loops of a run together
     size_t max_shapes = 1000000;          // shapes built, and shapes in the scene tree (a shared one counts at each use)
     size_t max_ops = 20000000;            // IR nodes
-    int max_nesting = 256;                // syntax nesting (parser)
+    int max_nesting = 1024;               // syntax nesting (parser): a modifier and its block count 2
     int max_shape_depth = 4000;           // depth of the shape tree
     size_t max_file_bytes = 16u << 20;    // per source file
 };

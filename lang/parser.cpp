@@ -17,6 +17,7 @@
 // frame is a local of the control's match, not a stack of its own.
 #include <algorithm>
 #include <atomic>
+#include <cassert>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -82,7 +83,7 @@ class ItemStack {
     std::unique_ptr<Item[]> data_;
     size_t size_ = 0, cap_ = 0;
 
-    void grow() {
+    [[gnu::noinline]] void grow() {
         size_t cap = cap_ ? 2 * cap_ : 256;
         std::unique_ptr<Item[]> d(new Item[cap]);
         std::copy(data_.get(), data_.get() + size_, d.get());
@@ -97,7 +98,7 @@ public:
     Item* end() { return data_.get() + size_; }
     Item& operator[](size_t i) { return data_[i]; }
     Item& back() { return data_[size_ - 1]; }
-    Item& emplace_back() {
+    [[gnu::always_inline]] Item& emplace_back() {
         if (size_ == cap_) grow();
         Item& it = data_[size_++];
         it = Item{};
@@ -157,9 +158,13 @@ struct State {
         items.resize_down(n);
     }
 
-    // The current rule's items; the action takes what it needs, then calls pop_frame().
+    // The current rule's items; the action takes all the nodes they own, then calls
+    // pop_frame().
     Frame take() { return Frame{items.data() + frame, items.size() - frame}; }
-    void pop_frame() { truncate(frame); }
+    void pop_frame() {
+        assert(std::all_of(items.begin() + frame, items.end(), [](const Item& it) { return !it.expr && !it.stmt; }));
+        items.resize_down(frame);
+    }
     // The item just below the current rule's frame (what a postfix rule extends), removed
     // from the stack; its expression is owned at once.
     ExprPtr take_below(Item& it) {
@@ -368,7 +373,7 @@ struct fold_action {
             lhs = std::move(e);
             st.check_height(acc.height, acc.loc);
         }
-        st.truncate(st.frame - 1);  // the chain and the left operand below it, all taken
+        st.items.resize_down(st.frame - 1);  // the chain and the left operand below it, all taken
         st.push_expr(std::move(lhs), acc.loc, acc.height);
     }
 };
@@ -792,6 +797,26 @@ struct action<g::block_expr_item> {
 
 // ---------------------------------------------------------------- control
 
+// Whether matching Rule may push items: it, or a rule below it, has an action. Recursion
+// (the grammar is recursive) is cut off at a depth, answering yes.
+template <template <typename...> class Action, typename Rule, int Depth>
+struct may_push;
+template <template <typename...> class Action, typename Subs, int Depth>
+struct any_may_push;
+template <template <typename...> class Action, typename... Subs, int Depth>
+struct any_may_push<Action, pegtl::type_list<Subs...>, Depth> {
+    static constexpr bool value = (may_push<Action, Subs, Depth>::value || ...);
+};
+template <template <typename...> class Action, typename Rule, int Depth>
+struct may_push {
+    static constexpr bool value = [] {
+        if constexpr (!std::is_base_of_v<pegtl::nothing<Rule>, Action<Rule>> || Depth >= 8)
+            return true;
+        else
+            return any_may_push<Action, typename Rule::subs_t, Depth + 1>::value;
+    }();
+};
+
 template <typename Rule>
 struct base_control : pegtl::normal<Rule> {
     template <pegtl::apply_mode A, pegtl::rewind_mode M, template <typename...> class Action,
@@ -805,6 +830,8 @@ struct base_control : pegtl::normal<Rule> {
         // PEGTL rewinds a rule with an action only after its failure hook ran, so the error
         // would point where the rule stopped, not where it started (see sdf_grammar.hpp).
         static_assert(!(error_point && framed), "an error point must not have an action");
+        // Most rule attempts (tokens, characters, lookaheads) push nothing: no bookkeeping.
+        constexpr bool tracked = A == pegtl::apply_mode::action && may_push<Action, Rule, 0>::value;
 
         struct DepthGuard {
             unsigned* depth;
@@ -815,19 +842,25 @@ struct base_control : pegtl::normal<Rule> {
         if constexpr (nests) {
             if (st.depth >= st.max_depth)
                 throw CompileError(st.loc_at(in.current()), fmt::format("nesting deeper than {} levels", st.max_depth));
+            // Whatever max_depth was raised to, stop before the C++ stack runs out.
+            if (stack_nearly_exhausted()) check_stack(st.loc_at(in.current()));
             ++st.depth;
             guard.depth = &st.depth;
         }
-        const size_t mark = st.items.size();
-        size_t outer_frame = 0;
-        if constexpr (framed) {
-            outer_frame = st.frame;
-            st.frame = mark;
+        if constexpr (!tracked) {
+            return pegtl::normal<Rule>::template match<A, mode, Action, Control>(in, st);
+        } else {
+            const size_t mark = st.items.size();
+            size_t outer_frame = 0;
+            if constexpr (framed) {
+                outer_frame = st.frame;
+                st.frame = mark;
+            }
+            const bool ok = pegtl::normal<Rule>::template match<A, mode, Action, Control>(in, st);
+            if constexpr (framed) st.frame = outer_frame;
+            if (!ok && st.items.size() > mark) st.truncate(mark);
+            return ok;
         }
-        const bool ok = pegtl::normal<Rule>::template match<A, mode, Action, Control>(in, st);
-        if constexpr (framed) st.frame = outer_frame;
-        if (!ok && st.items.size() > mark) st.truncate(mark);
-        return ok;
     }
 };
 
@@ -952,8 +985,8 @@ struct NodePool {
     static_assert(sizeof(PoolChunk) <= kHeader && Size % alignof(std::max_align_t) == 0);
     static constexpr size_t kFirstChunk = 64 << 10, kMaxChunk = 1 << 20;
 
-    void** free = nullptr;  // freed slots (a stack), malloc'ed
-    size_t count = 0, cap = 0;
+    void** free = nullptr;  // freed slots, reused first-in first-out: free[head, count); malloc'ed
+    size_t head = 0, count = 0, cap = 0;
     char* next = nullptr;   // the unused rest of the current chunk
     char* end = nullptr;
     size_t chunk_bytes = kFirstChunk;
@@ -971,11 +1004,23 @@ struct NodePool {
     }
 
     void* get() {
-        if (count != 0) return free[--count];
+        if (head != count) return take_free();
         if (next != end) return std::exchange(next, next + Size);
         return refill();
     }
+    // Oldest first: a tree is freed in about the order it was allocated, so the next parse
+    // gets its slots in about address order too.
+    void* take_free() {
+        void* p = free[head++];
+        if (head == count) head = count = 0;
+        return p;
+    }
     void put(void* p) noexcept {
+        if (count == cap && head != 0) {
+            std::memmove(static_cast<void*>(free), static_cast<void*>(free + head), (count - head) * sizeof(void*));
+            count -= head;
+            head = 0;
+        }
         if (count == cap && !grow()) {
             to_depot(p);
             return;
@@ -1005,13 +1050,13 @@ struct NodePool {
         Depot& d = depot();
         std::lock_guard<std::mutex> lock(d.mutex);
         try {
-            d.slots.insert(d.slots.end(), free, free + count);
+            d.slots.insert(d.slots.end(), free + head, free + count);
             for (; next != end; next += Size) d.slots.push_back(next);
         } catch (...) {
         }
         std::free(static_cast<void*>(free));
         free = nullptr;
-        count = cap = 0;
+        head = count = cap = 0;
         next = end = nullptr;
         exited = true;
     }
@@ -1049,7 +1094,7 @@ void* NodePool<Size>::refill() {
             }
         }
     }
-    if (count != 0) return free[--count];
+    if (head != count) return take_free();
     if (exited) return ::operator new(Size);  // a slot of its own, given to the depot when freed
     char* mem = static_cast<char*>(::operator new(chunk_bytes));
     auto* chunk = reinterpret_cast<PoolChunk*>(mem);

@@ -1,16 +1,15 @@
 #include "runtime/image.hpp"
 
-#include <unistd.h>
-
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <stdexcept>
 #include <system_error>
+
+#include "runtime/atomic_file.hpp"
 
 namespace sdfc {
 
@@ -61,12 +60,10 @@ float finite_or_zero(float v) { return std::isfinite(v) ? v : 0.0f; }
 // file in the same folder, then renames it onto `path`.
 void write_atomic(const std::string& path, int width, int height, const std::vector<std::string>& names,
                   OIIO::TypeDesc type, const void* data, bool linear) {
-    static std::atomic<unsigned> counter{0};
     const fs::path target(path);
     if (width <= 0 || height <= 0) throw std::runtime_error("cannot write '" + path + "': the image is empty");
-    // Keep the real extension last so OpenImageIO picks the format from the temporary name.
-    fs::path tmp = target.parent_path() / (target.stem().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                                           std::to_string(counter.fetch_add(1)) + target.extension().string());
+    // ".STEM.tmp-PID-N.EXT": the real extension last, so OpenImageIO picks the format.
+    const fs::path tmp = temp_path_for(path);
     auto fail = [&](const std::string& why) {
         std::error_code ec;
         fs::remove(tmp, ec);

@@ -11,11 +11,16 @@
 // om::min_ / om::max_ make, so a decided choice is the VM's choice at every point.
 #include "runtime/interval.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <iterator>
 #include <new>
 
 // A new opcode must get its interval semantics here: a missing case is an error.
@@ -43,11 +48,17 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr float kPi = 3.14159265358979f;
 
 // Outward widening by at least one ulp (two for normal numbers): dn(x) <= the float below x.
-SDFC_IV_INLINE float dn(float x) { return x - (std::fabs(x) * 0x1p-22f + 0x1p-126f); }
-SDFC_IV_INLINE float up(float x) { return x + (std::fabs(x) * 0x1p-22f + 0x1p-126f); }
+// Infinities stay (the margin is capped), NaN stays NaN.
+constexpr float kMaxF = std::numeric_limits<float>::max();
+SDFC_IV_INLINE float margin(float x, float rel, float abs) {
+    const float m = std::fabs(x) * rel + abs;
+    return m < kMaxF ? m : kMaxF;  // NaN compares false: NaN stays
+}
+SDFC_IV_INLINE float dn(float x) { return x - margin(x, 0x1p-22f, 0x1p-126f); }
+SDFC_IV_INLINE float up(float x) { return x + margin(x, 0x1p-22f, 0x1p-126f); }
 // Wider, for libm results (a few ulps between implementations).
-SDFC_IV_INLINE float dnw(float x) { return x - (std::fabs(x) * 0x1p-18f + 0x1p-120f); }
-SDFC_IV_INLINE float upw(float x) { return x + (std::fabs(x) * 0x1p-18f + 0x1p-120f); }
+SDFC_IV_INLINE float dnw(float x) { return x - margin(x, 0x1p-18f, 0x1p-120f); }
+SDFC_IV_INLINE float upw(float x) { return x + margin(x, 0x1p-18f, 0x1p-120f); }
 
 SDFC_IV_INLINE float mn(float a, float b) { return b < a ? b : a; }
 SDFC_IV_INLINE float mx(float a, float b) { return a < b ? b : a; }
@@ -94,15 +105,45 @@ SDFC_IV_INLINE void sin_iv(float l, float h, float peak_at, float (*f)(float), f
 float sinf_(float x) { return std::sin(x); }
 float cosf_(float x) { return std::cos(x); }
 
+// Unknown intervals. Invariant: if a point of the box may give NaN, or the interval is
+// unknown, both ends are NaN; NaN ends never decide a choice (comparisons are false). An
+// op keeps it by adding z (0, or NaN) to both ends, z from one of:
+//   Inputs  NaN when an operand has a NaN or infinite end (x * 0 is NaN for inf and NaN;
+//           a finite sum that overflows only makes the result unknown needlessly)
+//   Result  NaN when the result has a NaN or infinite end: enough for ops whose formulas
+//           carry a NaN or infinite operand end into the result (add, sub)
+//   B       NaN when operand b has one: min/max carry a's NaN ends (mn(NaN, x) is NaN)
+//           but not b's, and infinities are fine for them
+//   None    ops that carry NaN ends and make no NaN from finite or infinite operands
+//           (plus explicit domain checks: the root of a negative number, ...)
+enum class Poison { Inputs, Result, B, None };
+template <Op O>
+constexpr Poison poison_kind() {
+    switch (O) {
+        case Op::Add: case Op::Sub: case Op::AddI: case Op::SubI: return Poison::Result;
+        case Op::Min: case Op::Max: return Poison::B;
+        case Op::Const: case Op::VarX: case Op::VarY: case Op::VarZ: case Op::Time: case Op::Copy: case Op::Neg:
+        case Op::MinI: case Op::MaxI: case Op::Sqrt: return Poison::None;
+        default: return Poison::Inputs;
+    }
+}
+
 // The interval semantics of op O: [al, ah] etc. in, [lo, hi] and the choice out.
 template <Op O>
 SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float ch, float k, float& lo, float& hi,
                        uint8_t& choice) {
     choice = kChoiceBoth;
     constexpr int arity = kOpInfo[int(O)].arity;
-    float z = arity >= 1 ? poison(al, ah) : 0.0f;
-    if constexpr (arity >= 2) z += poison(bl, bh);
-    if constexpr (arity >= 3) z += poison(cl, ch);
+    constexpr Poison P = poison_kind<O>();
+    float z = 0.0f;
+    if constexpr (P == Poison::Inputs) {
+        z = arity >= 1 ? al + ah : 0.0f;
+        if constexpr (arity >= 2) z += bl + bh;
+        if constexpr (arity >= 3) z += cl + ch;
+        z *= 0.0f;
+    } else if constexpr (P == Poison::B) {
+        z = (bl + bh) * 0.0f;
+    }
     switch (O) {
         case Op::Const: lo = hi = k; return;
         case Op::VarX:
@@ -352,6 +393,7 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
         }
         case Op::Noise3: lo = -2.001f; hi = 2.001f; break;
     }
+    if constexpr (P == Poison::Result) z += (lo + hi) * 0.0f;
     lo += z;
     hi += z;
 }
@@ -420,24 +462,36 @@ void Tape::link() {
     links.resize(n);
     thread_local std::vector<uint32_t> last;
     last.assign(std::max<uint32_t>(num_regs, uint32_t(out) + 1), kNone);
+    const size_t nregs = last.size();
+    bool regs_ok = true;
+    if (!well_formed)
+        for (const Instr& in : code) regs_ok &= (in.out < nregs) & (in.a < nregs) & (in.b < nregs) & (in.c < nregs);
+    if (!regs_ok) {
+        linked = false;
+        return;
+    }
     uint32_t sl = 0;
-    uint32_t missing = 0;  // operands read before any write
     for (size_t i = 0; i < n; ++i) {
         const Instr& in = code[i];
-        const int ar = kOpInfo[int(in.op)].arity;
         Link& l = links[i];
-        l.def[0] = ar > 0 ? last[in.a] : kNone;
-        l.def[1] = ar > 1 ? last[in.b] : kNone;
-        l.def[2] = ar > 2 ? last[in.c] : kNone;
-        missing |= (ar > 0 && l.def[0] == kNone) | (ar > 1 && l.def[1] == kNone) | (ar > 2 && l.def[2] == kNone);
-        const bool ch = is_choice_op(in.op);
+        // Unused operand fields hold some register number: their "def" is never read.
+        l.def[0] = last[in.a];
+        l.def[1] = last[in.b];
+        l.def[2] = last[in.c];
+        const uint32_t ch = uint32_t((kChoiceMask >> int(in.op)) & 1);
         l.slot = ch ? sl : kNone;
         sl += ch;
         last[in.out] = uint32_t(i);
     }
     choices = sl;
     out_def = last[out];
-    linked = !missing;  // a tape reading unwritten registers cannot be followed by def links
+    linked = true;
+    if (!well_formed) {
+        // A tape reading unwritten registers cannot be followed by def links.
+        for (size_t i = 0; i < n && linked; ++i)
+            for (int j = 0; j < kOpInfo[int(code[i].op)].arity; ++j) linked &= links[i].def[j] != kNone;
+        well_formed = linked;
+    }
 }
 
 IntervalEvaluator::IntervalEvaluator(uint32_t max_regs, uint32_t max_choices)
@@ -447,7 +501,7 @@ IntervalEvaluator::IntervalEvaluator(uint32_t max_regs, uint32_t max_choices)
       hi_store_(alloc_floats(size_t(max_regs_) * kIvLanes), &free_aligned),
       lo_(lo_store_.get()),
       hi_(hi_store_.get()),
-      choices_(new uint8_t[std::max<size_t>(size_t(max_choices) * kIvLanes, 1)]) {}
+      choices_(new uint8_t[size_t(max_choices) * kIvLanes + 64]) {}  // + 64: whole-vector reads past a row
 
 void IntervalEvaluator::eval(const Tape& t, const float* xlo, const float* xhi, const float* ylo, const float* yhi,
                              const float* zlo, const float* zhi, int n, float time) {
@@ -519,6 +573,7 @@ void simplify(const Tape& parent, const uint8_t* choices, int stride, int lane, 
     const size_t n = parent.code.size();
     out.code.clear();
     out.linked = false;
+    out.well_formed = false;
     out.out = 0;
     out.num_regs = 1;
     out.choices = 0;
@@ -548,14 +603,27 @@ void simplify(const Tape& parent, const uint8_t* choices, int stride, int lane, 
     const uint8_t* cp = choices + lane;
     const Instr* code = parent.code.data();
     const Tape::Link* links = parent.links.data();
+    // A decided choice op whose winner is a register is skipped: its users read the winner
+    // directly (following chains of them).
+    auto chase = [&](uint32_t d) -> uint32_t {
+        for (;;) {
+            const uint32_t sl = links[d].slot;
+            if (sl == Tape::kNone) return d;
+            const uint8_t ch = cp[size_t(sl) * size_t(stride)];
+            if (ch == kChoiceBoth) return d;
+            if (ch == kChoiceB && (code[d].op == Op::MinI || code[d].op == Op::MaxI)) return d;  // becomes a Const
+            d = links[d].def[ch - 1];
+        }
+    };
     {
-        const uint32_t o = parent.out_def;
+        const uint32_t o = chase(parent.out_def);
         live[o >> 6] |= uint64_t(1) << (o & 63);
         bind[o] = alloc();
     }
     // The register holding the value of instruction d, allocating one at its last use
     // (the first met walking backwards).
     auto use = [&](uint32_t d) -> uint16_t {
+        d = chase(d);
         uint64_t& w = live[d >> 6];
         const uint64_t bit = uint64_t(1) << (d & 63);
         if (!(w & bit)) {
@@ -573,52 +641,256 @@ void simplify(const Tape& parent, const uint8_t* choices, int stride, int lane, 
             const Instr in = code[i];
             const Tape::Link& l = links[i];
             const uint16_t X = bind[i];
+            release(X);  // before the operands: the result may reuse an operand's register
             if (l.slot != Tape::kNone) {
-                const uint8_t ch = cp[size_t(l.slot) * size_t(stride)];
-                if (ch != kChoiceBoth) {
-                    if (ch == kChoiceB && (in.op == Op::MinI || in.op == Op::MaxI)) {
-                        Instr c{Op::Const};
-                        c.out = X;
-                        c.k = in.k;
-                        rev[nrev++] = c;
-                        release(X);
-                        continue;
-                    }
-                    const uint32_t d = l.def[ch - 1];
-                    uint64_t& dw = live[d >> 6];
-                    const uint64_t bit = uint64_t(1) << (d & 63);
-                    if (!(dw & bit)) {
-                        dw |= bit;
-                        bind[d] = X;  // the winner's value lives in X: no instruction
-                    } else {
-                        Instr c{Op::Copy};
-                        c.out = X;
-                        c.a = bind[d];
-                        rev[nrev++] = c;
-                        release(X);
-                    }
+                if (cp[size_t(l.slot) * size_t(stride)] != kChoiceBoth) {
+                    // MinI/MaxI whose immediate wins (chase() stops there): a constant.
+                    Instr c{Op::Const};
+                    c.out = X;
+                    c.k = in.k;
+                    rev[nrev++] = c;
                     continue;
                 }
                 ++nch;
             }
-            release(X);  // before the operands: the result may reuse an operand's register
             Instr e{in.op};
             e.out = X;
             e.k = in.k;
-            switch (kOpInfo[int(in.op)].arity) {
-                case 3: e.c = use(l.def[2]); [[fallthrough]];
-                case 2: e.b = use(l.def[1]); [[fallthrough]];
-                case 1: e.a = use(l.def[0]); break;
-                default: break;
-            }
+            // Operand a first: it gets the output's register when it dies here, so a later
+            // trace (simplify_batch) of this tape needs no copy when a wins a choice (the
+            // common case: the accumulated side of a min/max chain).
+            const int ar = kOpInfo[int(in.op)].arity;
+            if (ar >= 1) e.a = use(l.def[0]);
+            if (ar >= 2) e.b = use(l.def[1]);
+            if (ar >= 3) e.c = use(l.def[2]);
             rev[nrev++] = e;
         }
     }
-    out.code.resize(nrev);
-    for (size_t j = 0; j < nrev; ++j) out.code[j] = rev[nrev - 1 - j];
+    out.code.assign(std::make_reverse_iterator(rev + nrev), std::make_reverse_iterator(rev));
     out.out = 0;  // the output was bound first
     out.num_regs = std::max<uint32_t>(next, 1);
     out.choices = nch;
+    out.well_formed = true;
+    out.link();  // ready to be simplified further
+}
+
+namespace {
+
+// Lanes (of the first 64) whose choice byte in `row` equals v.
+inline uint64_t lanes_equal(const uint8_t* row, uint8_t v) {
+#if defined(__SSE2__)
+    const __m128i want = _mm_set1_epi8(char(v));
+    uint64_t m = 0;
+    for (int q = 0; q < 4; ++q) {
+        __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + 16 * q));
+        m |= uint64_t(uint32_t(_mm_movemask_epi8(_mm_cmpeq_epi8(x, want)) & 0xFFFF)) << (16 * q);
+    }
+    return m;
+#else
+    uint64_t m = 0;
+    for (int i = 0; i < 64; ++i) m |= uint64_t(row[i] == v) << i;
+    return m;
+#endif
+}
+
+}  // namespace
+
+void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s,
+                    bool compact) {
+    const size_t n = parent.code.size();
+    s.len.fill(0);
+    s.out.fill(0);
+    s.cap = n;
+    if (s.buf_size < 64 * n) {
+        s.buf.reset(static_cast<Instr*>(::operator new(sizeof(Instr) * 64 * n)));
+        s.buf_size = 64 * n;
+    }
+    Instr* buf = s.buf.get();
+    if (lanes == 0) return;
+    if (!parent.linked || parent.out_def == Tape::kNone) {
+        for (uint64_t m = lanes; m; m &= m - 1) {
+            const int j = __builtin_ctzll(m);
+            std::copy(parent.code.begin(), parent.code.end(), buf + size_t(j) * n);
+            s.start[size_t(j)] = 0;
+            s.len[size_t(j)] = uint32_t(n);
+            s.regs[size_t(j)] = parent.num_regs;
+            s.out[size_t(j)] = parent.out;
+        }
+        return;
+    }
+    // Backwards: the lanes in which each instruction's value is needed.
+    if (s.mask.size() < n) s.mask.resize(n);
+    uint64_t* need = s.mask.data();
+    std::fill_n(need, n, uint64_t(0));
+    need[parent.out_def] = lanes;
+    const Instr* code = parent.code.data();
+    const Tape::Link* links = parent.links.data();
+    for (size_t i = n; i-- > 0;) {
+        const uint64_t m = need[i];
+        if (!m) continue;
+        const Instr& in = code[i];
+        const Tape::Link& l = links[i];
+        const int ar = kOpInfo[int(in.op)].arity;
+        if (l.slot == Tape::kNone) {
+            if (ar > 0) need[l.def[0]] |= m;
+            if (ar > 1) need[l.def[1]] |= m;
+            if (ar > 2) need[l.def[2]] |= m;
+            continue;
+        }
+        const uint8_t* row = choices + size_t(l.slot) * size_t(stride);
+        const uint64_t ca = lanes_equal(row, kChoiceA), cb = lanes_equal(row, kChoiceB);
+        const uint64_t cc = in.op == Op::Select ? lanes_equal(row, kChoiceC) : 0;
+        const uint64_t both = m & ~(ca | cb | cc);
+        need[l.def[0]] |= in.op == Op::Select ? both : (m & (ca | both));
+        if (in.op == Op::Min || in.op == Op::Max || in.op == Op::Select) need[l.def[1]] |= m & (cb | both);
+        if (in.op == Op::Select) need[l.def[2]] |= m & (cc | both);
+    }
+    if (!compact) {
+        // Forwards: each lane's instructions in the parent's registers. A decided choice op
+        // becomes a copy of the winner into its output register (nothing when the winner is
+        // already there) or, for an immediate, a constant.
+        std::array<uint32_t, 64> cnt{};
+        for (size_t i = 0; i < n; ++i) {
+            uint64_t m = need[i];
+            if (!m) continue;
+            const Instr in = code[i];
+            const uint32_t sl = links[i].slot;
+            if (sl == Tape::kNone) {
+                for (; m; m &= m - 1) {
+                    const size_t j = size_t(__builtin_ctzll(m));
+                    buf[j * n + cnt[j]++] = in;
+                }
+                continue;
+            }
+            const uint8_t* row = choices + size_t(sl) * size_t(stride);
+            for (; m; m &= m - 1) {
+                const size_t j = size_t(__builtin_ctzll(m));
+                const uint8_t ch = row[j];
+                if (ch == kChoiceBoth) {
+                    buf[j * n + cnt[j]++] = in;
+                    continue;
+                }
+                Instr c{Op::Copy};
+                c.out = in.out;
+                if (ch == kChoiceB && (in.op == Op::MinI || in.op == Op::MaxI)) {
+                    c.op = Op::Const;
+                    c.k = in.k;
+                } else {
+                    c.a = ch == kChoiceA ? in.a : (ch == kChoiceB ? in.b : in.c);
+                    if (c.a == c.out) continue;  // the winner is already in place
+                }
+                buf[j * n + cnt[j]++] = c;
+            }
+        }
+        for (uint64_t lm = lanes; lm; lm &= lm - 1) {
+            const size_t j = size_t(__builtin_ctzll(lm));
+            s.start[j] = 0;
+            s.len[j] = cnt[j];
+            s.regs[j] = parent.num_regs;
+            s.out[j] = parent.out;
+        }
+        return;
+    }
+    // Forwards: each lane's live instructions, as parent indices in order.
+    if (s.idx_size < 64 * n) {
+        s.idx.reset(new uint32_t[64 * n]);
+        s.idx_size = 64 * n;
+    }
+    uint32_t* idx = s.idx.get();
+    std::array<uint32_t, 64> cnt{};
+    for (size_t i = 0; i < n; ++i)
+        for (uint64_t m = need[i]; m; m &= m - 1) {
+            const size_t j = size_t(__builtin_ctzll(m));
+            idx[j * n + cnt[j]++] = uint32_t(i);
+        }
+    // Per lane, backwards over its live instructions: registers re-allocated (linear scan;
+    // an op's output may share a dying operand's register, which the lane-wise VM allows);
+    // a decided choice op's winner takes over its output register (no instruction), or is
+    // copied when it stays needed elsewhere; an immediate that wins becomes a constant.
+    constexpr uint16_t kFree = 0xFFFF;
+    const size_t nregs = std::max<size_t>(parent.num_regs, size_t(parent.out) + 1);
+    if (s.bind.size() < nregs) s.bind.resize(nregs);
+    if (s.free_regs.size() < n + 1) s.free_regs.resize(n + 1);
+    uint16_t* bind = s.bind.data();
+    uint16_t* free_regs = s.free_regs.data();
+    for (uint64_t lm = lanes; lm; lm &= lm - 1) {
+        const size_t j = size_t(__builtin_ctzll(lm));
+        std::fill_n(bind, nregs, kFree);
+        size_t nfree = 0;
+        uint16_t next = 0;
+        auto alloc = [&]() -> uint16_t { return nfree ? free_regs[--nfree] : next++; };
+        Instr* out = buf + j * n + n;  // written backwards from the end of the lane's block
+        size_t nout = 0;
+        bind[parent.out] = alloc();
+        const uint32_t* list = idx + j * n;
+        for (size_t q = cnt[j]; q-- > 0;) {
+            const uint32_t i = list[q];
+            const Instr& in = code[i];
+            const uint16_t X = bind[in.out];
+            if (X == kFree) continue;  // (cannot happen: the lane needs every listed value)
+            bind[in.out] = kFree;
+            const uint32_t sl = links[i].slot;
+            const uint8_t ch = sl == Tape::kNone ? uint8_t(kChoiceBoth) : choices[size_t(sl) * size_t(stride) + j];
+            if (ch != kChoiceBoth) {
+                if (ch == kChoiceB && (in.op == Op::MinI || in.op == Op::MaxI)) {
+                    Instr c{Op::Const};
+                    c.out = X;
+                    c.k = in.k;
+                    *--out = c;
+                    ++nout;
+                    free_regs[nfree++] = X;
+                    continue;
+                }
+                const uint16_t w = ch == kChoiceA ? in.a : (ch == kChoiceB ? in.b : in.c);
+                if (bind[w] == kFree) {
+                    bind[w] = X;  // the winner's value lives in X: no instruction
+                } else {
+                    Instr c{Op::Copy};
+                    c.out = X;
+                    c.a = bind[w];
+                    *--out = c;
+                    ++nout;
+                    free_regs[nfree++] = X;
+                }
+                continue;
+            }
+            free_regs[nfree++] = X;  // before the operands: the result may reuse one's register
+            Instr e{in.op};
+            e.out = X;
+            e.k = in.k;
+            {
+                // Operand a first: it gets the output's register when it dies here (see simplify()).
+                const int ar = kOpInfo[int(in.op)].arity;
+                if (ar >= 1) {
+                    if (bind[in.a] == kFree) bind[in.a] = alloc();
+                    e.a = bind[in.a];
+                }
+                if (ar >= 2) {
+                    if (bind[in.b] == kFree) bind[in.b] = alloc();
+                    e.b = bind[in.b];
+                }
+                if (ar >= 3) {
+                    if (bind[in.c] == kFree) bind[in.c] = alloc();
+                    e.c = bind[in.c];
+                }
+            }
+            *--out = e;
+            ++nout;
+        }
+        s.start[j] = uint32_t(n - nout);
+        s.len[j] = uint32_t(nout);
+        s.regs[j] = std::max<uint32_t>(next, 1);
+    }
+}
+
+void Tape::assign(const Instr* c, size_t count, uint16_t out_reg, uint32_t regs) {
+    code.assign(c, c + count);
+    out = out_reg;
+    num_regs = regs;
+    linked = false;
+    well_formed = true;  // simplify_batch's output
+    links.clear();
+    out_def = kNone;
 }
 
 }  // namespace sdfc

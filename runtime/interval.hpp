@@ -9,6 +9,7 @@
 // infinite); it never decides a choice and propagates through every op.
 #pragma once
 #include <cstdint>
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -52,8 +53,10 @@ struct Tape {
     std::vector<Link> links;
     uint32_t out_def = kNone;    // the instruction defining the output
     bool linked = false;
+    bool well_formed = false;    // known: every operand is written before it is read (simplify's output)
 
     static Tape from(const Program& p, int output = 0);
+    void assign(const Instr* code, size_t count, uint16_t out_reg, uint32_t regs);  // a child of simplify_batch
     void recount();  // sets num_regs and choices from code
     void link();     // fills links and out_def
 };
@@ -98,8 +101,35 @@ struct SimplifyScratch {
 // code goes, and registers are re-allocated (backwards linear scan; an op's output may
 // share an operand's register, which the lane-wise VM allows). Only live instructions are
 // visited (def links), so the cost is about the size of the result. `out` computes exactly
-// what `parent` computes at every point of that box; it is not linked (call link() before
-// simplifying it further).
+// what `parent` computes at every point of that box, and is linked (ready to be simplified
+// further). A parent that is not linked (or reads unwritten registers) is copied as is.
 void simplify(const Tape& parent, const uint8_t* choices, int stride, int lane, Tape& out, SimplifyScratch& s);
+
+// Scratch and result of simplify_batch: lane j's tape is code(j)[0 .. len[j]), output
+// register out[j], regs[j] registers.
+struct BatchScratch {
+    std::vector<uint64_t> mask;  // per parent instruction: lanes needing its value
+    std::unique_ptr<Instr[], void (*)(Instr*)> buf{nullptr, [](Instr* p) { ::operator delete(p); }};
+    std::unique_ptr<uint32_t[]> idx;  // per lane: live parent instructions
+    size_t buf_size = 0, idx_size = 0, cap = 0;
+    std::vector<uint16_t> bind, free_regs;
+    std::array<uint32_t, 64> start{}, len{}, regs{};
+    std::array<uint16_t, 64> out{};
+    const Instr* code(int lane) const { return buf.get() + size_t(lane) * cap + start[size_t(lane)]; }
+};
+
+// simplify() for many boxes at once: for each lane in `lanes` (bits of the last
+// IntervalEvaluator::eval of `parent`), a tape computing what `parent` computes in that
+// lane's box. One backward pass over the parent finds every lane's live instructions (64
+// lanes at once, as bit masks, following only the winners of decided choices). Then
+//   compact: each lane's short list alone is register-allocated, decided choices vanish
+//            (the winner takes over the register): the same tapes as simplify();
+//   else:    a trace: the live instructions in the parent's registers, a decided choice
+//            op replaced by a copy of its winner (nothing if already in place) or by a
+//            constant. Cheaper to make, a little longer: for tapes evaluated once
+//            (leaves), not for parents of further simplification (copies would pile up).
+// The cost is about the parent's length plus the results' lengths.
+void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s,
+                    bool compact = true);
 
 }  // namespace sdfc

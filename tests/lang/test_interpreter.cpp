@@ -179,3 +179,14 @@ TEST_CASE("materials are values and modifiers; the inner one wins") {
     CHECK(b[3] == Approx(1));
     CHECK(b[1] == Approx(0));
 }
+
+TEST_CASE("materials blend across smooth operations") {
+    auto c = test::compile_text(
+        "smooth_union(1) { material(color = [1, 0, 0]) sphere(1); material(color = [0, 0, 1]) translate([1.5, 0, 0]) sphere(1); }");
+    auto mid = eval_scalar(c->cs.shading, 0.75f, 0, 0);  // equidistant: an even blend
+    CHECK(mid[1] == Approx(0.5).margin(1e-5));
+    CHECK(mid[3] == Approx(0.5).margin(1e-5));
+    auto left = eval_scalar(c->cs.shading, -0.9f, 0, 0);  // far from the blend: pure red
+    CHECK(left[1] == Approx(1));
+    CHECK(left[3] == Approx(0));
+}

@@ -2,6 +2,10 @@
 // locations, syntax errors (exact text and position) and the nesting limit.
 #include <catch2/catch.hpp>
 
+#include <charconv>
+#include <cstring>
+#include <thread>
+
 #include <fmt/format.h>
 
 #include "grammar/sdf_grammar.hpp"
@@ -725,6 +729,93 @@ TEST_CASE("the nesting limit is a parameter", "[parser]") {
     s = "x = 0";
     for (int i = 0; i < 500; ++i) s += " + 1";
     CHECK_NOTHROW(parse_text(s + ";"));
+}
+
+// ------------------------------------------------------- fast paths (sdf_grammar.hpp "Speed")
+
+TEST_CASE("numbers: the fast path rounds exactly as from_chars", "[parser]") {
+    for (const char* s : {"0.1", "0.3", "2.675", "1.", "0.000001", "99999.99999", "123456789012345", "1234567890123456",
+                          "9007199254740993", ".000000000000001", "00000000000001.5", "4.35", "1e-7", "12345.678e3"}) {
+        double expect = 0;
+        std::from_chars(s, s + std::strlen(s), expect);
+        Parsed p = parse_text(std::string("x = ") + s + ";");
+        INFO(s);
+        CHECK(p.stmt(0).value->number == expect);
+    }
+}
+
+TEST_CASE("guards: what is not an operator, postfix or target", "[parser]") {
+    CHECK(error_of("x = a -> b;") == "1:6: expected ';' after the statement");
+    CHECK(error_of("x = a - > b;") == "1:9: expected an expression after the operator");
+    CHECK(error_of("x = a !b;") == "1:6: expected ';' after the statement");
+    CHECK(error_of("x = a = = b;") == "1:6: expected ';' after the statement");
+    CHECK(error_of("x = a == = b;") == "1:10: expected an expression after the operator");
+    CHECK(error_of("x = a & & b;") == "1:7: unexpected character '&' (did you mean '&&'?)");
+    CHECK(error_of("x = a ?;") == "1:8: expected an expression after '?'");
+    CHECK(error_of("x = f(a) . 5;") == "1:11: unexpected character ' '");
+    CHECK(error_of("translate(v) !a;") == "1:13: expected ';' after the statement");
+    CHECK(error_of("a b -> c;") == "1:4: expected ';' after the statement");
+    CHECK(error_of("x = - - -;") == "1:10: expected an expression after '-'");
+    CHECK(sx1("translate(v) -1;") == "(- (call translate v) 1)");
+    CHECK(ex("--a") == "(neg (neg a))");
+    CHECK(ex("!!a") == "(not (not a))");
+    CHECK(ex("v[1](2).x") == "(.x (call (index v 1) 2))");
+    CHECK(ex("iff + for_ + true1 + _let + let_ + LET + imports + Field") ==
+          "(+ (+ (+ (+ (+ (+ (+ iff for_) true1) _let) let_) LET) imports) Field)");
+}
+
+TEST_CASE("whitespace and comments: every form", "[parser]") {
+    CHECK(sx1("let\tx\v=\f1;") == "let x = 1");
+    CHECK(parse_text("a; //").size() == 1);
+    CHECK(parse_text("a; //\r\nb;").size() == 2);
+    CHECK(parse_text("a//c\n;").size() == 1);
+    CHECK(parse_text("a/**//**/;").size() == 1);
+    CHECK(parse_text("a /* * / */ ;").size() == 1);
+    CHECK(ex("1 /*/ 2 */ / 2") == "(/ 1 2)");
+    CHECK(error_of("a; /*") == "1:4: unterminated comment");
+    CHECK(error_of("a; /* */ */") == "1:10: expected a statement");
+    Parsed p = parse_text("a; // x\r\n  /* y\n z */ b;");
+    CHECK(p.stmt(1).loc.line == 3);
+    CHECK(p.stmt(1).loc.col == 7);
+}
+
+TEST_CASE("a long script: locations and repeated parses", "[parser]") {
+    std::string text;
+    for (int i = 0; i < 3000; ++i)
+        text += i % 3 == 0 ? fmt::format("translate([{}, 0, 1]) sphere(s);\n", i)
+                : i % 3 == 1 ? fmt::format("  let v{} = [{}, 1] * 0.5; // note\n", i, i)
+                             : fmt::format("rotate(y = {}) /* c */ box([1, 2, 3]);\n", i);
+    Parsed a = parse_text(text);
+    REQUIRE(a.size() == 3000);
+    CHECK(a.stmt(2999).loc.line == 3000);
+    CHECK(a.stmt(2998).loc.col == 3);
+    CHECK(a.stmt(2998).name == "v2998");
+    CHECK(a.stmt(2998).name_loc.col == 7);
+    const Expr& v = *a.stmt(2998).value;  // [2998, 1] * 0.5: the operator's location
+    CHECK(v.loc.line == 2999);
+    CHECK(v.loc.col == 25);
+    CHECK(sx_stmt(&a.stmt(1500)) == "(apply (call translate [1500 0 1]) (call sphere s))");
+    // Parsing again (reusing freed nodes) builds the same tree.
+    std::string first = dump(*a.module);
+    a.module.reset();
+    Parsed b = parse_text(text);
+    CHECK(dump(*b.module) == first);
+}
+
+TEST_CASE("trees may be built and freed on different threads", "[parser]") {
+    const std::string text = "translate([1, 0, 2]) sphere(s);\nlet v = [1, 2, 3] * 0.5;\ndef f(a, b = 2) { a + b }\n";
+    SourceFile f("t.sdf", text);
+    std::vector<std::unique_ptr<Module>> kept;
+    for (int round = 0; round < 4; ++round) {
+        std::thread t([&] {
+            for (int i = 0; i < 20; ++i) parse(f);                 // built and freed here
+            kept.push_back(parse(f));                              // freed on the main thread
+            if (kept.size() > 2) kept.erase(kept.begin());         // built on the main thread, freed here
+        });
+        t.join();
+        kept.push_back(parse(f));
+    }
+    for (const auto& m : kept) CHECK(dump(*m) == dump(*parse(f)));
 }
 
 // --------------------------------------------------------------------------- dump

@@ -1,0 +1,118 @@
+// Every safety limit through the sdfc command: the default stops the script with a located
+// diagnostic (exit 1, no output file), and its flag raises it (docs/language.md, Limits).
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+
+#include "run.hpp"
+
+using namespace sdfc;
+using test::run_sdfc;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string first_line(const std::string& s) { return s.substr(0, s.find('\n')); }
+
+std::string repeat(const std::string& s, int n) {
+    std::string out;
+    for (int i = 0; i < n; ++i) out += s;
+    return out;
+}
+
+// `sdfc check FILE FLAGS`: exit status and the first line of stderr.
+std::pair<int, std::string> check(const std::string& file, const std::string& flags = "") {
+    auto r = run_sdfc("check '" + file + "' " + flags);
+    return {r.status, first_line(r.err)};
+}
+
+}  // namespace
+
+TEST_CASE("flag --max-recursion") {
+    std::string s = test::write_temp("lim_rec.sdf", "def f(n) = n > 0 ? f(n - 1) + 1 : 0;\nsphere(f(100) / 100);\n");
+    CHECK(check(s) == std::pair<int, std::string>{1, s + ":1:20: error: recursion deeper than 64 calls in 'f' (raise it with --max-recursion)"});
+    CHECK(check(s, "--max-recursion 101").first == 0);
+    CHECK(check(s, "--max-recursion 0").second == "sdfc: error: --max-recursion must be from 1 to 100000, not 0");
+}
+
+TEST_CASE("flag --max-iterations (one loop, and all loops together)") {
+    std::string s = test::write_temp("lim_it.sdf", "field (p) -> { var d = p.x; for (i = [1 : 150000]) d = d + 0; d };\n");
+    CHECK(check(s) == std::pair<int, std::string>{1, s + ":1:38: error: this range has 150000 elements, over the loop limit of 100000 (raise it with --max-iterations)"});
+    CHECK(check(s, "--max-iterations 150000").first == 0);
+}
+
+TEST_CASE("flag --max-calls") {
+    std::string s = test::write_temp("lim_calls.sdf", "def f(n) = n > 0 ? f(n - 1) + f(n - 1) : 1;\nsphere(f(12) / 4096);\n");
+    auto [st, err] = check(s, "--max-calls 1000");
+    CHECK(st == 1);
+    CHECK(err.find("error: the script made more than 1000 calls in all") != std::string::npos);
+    CHECK(err.rfind(s + ":1:", 0) == 0);
+    CHECK(check(s).first == 0);
+}
+
+TEST_CASE("flag --max-shapes and --max-shape-depth") {
+    std::string s = test::write_temp("lim_shapes.sdf", "for (i = [0 : 199]) translate([i, 0, 0]) sphere(0.4);\n");
+    auto [st, err] = check(s, "--max-shapes 100");
+    CHECK(st == 1);
+    CHECK(err == s + ":1:42: error: the scene has more than 100 shapes (raise it with --max-shapes)");
+    CHECK(check(s, "--max-shapes 1000").first == 0);
+    std::string d = test::write_temp("lim_depth.sdf", "def f(n) = n > 0 ? translate([0, 0.1, 0]) f(n - 1) : sphere(1);\nf(30);\n");
+    CHECK(check(d, "--max-shape-depth 10") ==
+          std::pair<int, std::string>{1, d + ":1:20: error: shapes nested more than 10 deep (raise it with --max-shape-depth)"});
+    CHECK(check(d).first == 0);
+}
+
+TEST_CASE("flag --max-ops") {
+    std::string s = test::write_temp("lim_ops.sdf",
+        "field (p) -> { var d = p.x; for (i = [1 : 100]) d = min(d, length(p - [i, 0, 0]) - 0.5); d };\n");
+    auto [st, err] = check(s, "--max-ops 300");
+    CHECK(st == 1);
+    CHECK(err.find("error: the program grew past 300 operations (raise it with --max-ops)") != std::string::npos);
+    CHECK(check(s).first == 0);
+}
+
+TEST_CASE("flag --max-nesting, and 100,000 nested parentheses never crash") {
+    std::string s = test::write_temp("lim_nest.sdf", "sphere(" + repeat("(", 1100) + "1" + repeat(")", 1100) + ");\n");
+    CHECK(check(s) == std::pair<int, std::string>{1, s + ":1:1031: error: nesting deeper than 1024 levels"});
+    CHECK(check(s, "--max-nesting 2000").first == 0);
+    std::string deep = test::write_temp("lim_deep.sdf", "sphere(" + repeat("(", 100000) + "1" + repeat(")", 100000) + ");\n");
+    auto [st, err] = check(deep, "--max-nesting 10000");
+    CHECK(st == 1);
+    std::string blocks = test::write_temp("lim_blocks.sdf", repeat("{", 100000) + "sphere(1);" + repeat("}", 100000) + "\n");
+    CHECK(check(blocks, "--max-nesting 10000").first == 1);
+    CHECK(check(blocks, "--max-nesting 100000").second == "sdfc: error: --max-nesting must be from 1 to 10000, not 100000");
+    CHECK(check(blocks).second.find("error: nesting deeper than 1024 levels") != std::string::npos);
+}
+
+TEST_CASE("flag --max-file-size") {
+    std::string s = test::write_temp("lim_size.sdf", "// " + std::string(2000, '-') + "\nsphere(1);\n");
+    CHECK(check(s, "--max-file-size 1000") ==
+          std::pair<int, std::string>{1, "sdfc: error: '" + s + "' is 2015 bytes, over the limit of 1000 bytes (--max-file-size)"});
+    CHECK(check(s).first == 0);
+}
+
+TEST_CASE("flag --max-pixels (width x height x samples) and --max-frames; no output is written") {
+    std::string s = test::write_temp("lim_px.sdf", "render(width = 200, height = 100, samples = 4);\nsphere(1);\n");
+    std::string out = test::temp_dir() + "/lim_px.png";
+    fs::remove(out);
+    auto r = run_sdfc("render '" + s + "' -o '" + out + "' --quiet --max-pixels 50000");
+    CHECK(r.status == 1);
+    CHECK(first_line(r.err) == s + ":1:1: error: 200x100 pixels at 4 samples is over the limit of 50000 (raise it with --max-pixels)");
+    CHECK(!fs::exists(out));
+    r = run_sdfc("render '" + s + "' -o '" + out + "' --quiet --width 300 --samples 1 --max-pixels 20000");
+    CHECK(r.status == 1);
+    CHECK(first_line(r.err) == "sdfc: error: 300x100 pixels at 1 samples is over the limit of 20000 (raise it with --max-pixels)");
+    CHECK(!fs::exists(out));
+    r = run_sdfc("render '" + s + "' -o '" + out + "' --quiet --width 20 --height 10 --samples 1 --max-pixels 200");
+    CHECK(r.status == 0);
+    CHECK(fs::exists(out));
+
+    std::string pattern = test::temp_dir() + "/lim_frame_{frame:04d}.png";
+    r = run_sdfc("render '" + s + "' -o '" + pattern + "' --quiet --width 8 --height 8 --frames 0:9 --max-frames 5");
+    CHECK(r.status == 1);
+    CHECK(first_line(r.err) == "sdfc: error: 10 frames is over the limit of 5 (raise it with --max-frames)");
+    CHECK(!fs::exists(test::temp_dir() + "/lim_frame_0000.png"));
+    r = run_sdfc("render '" + s + "' -o '" + pattern + "' --quiet --width 8 --height 8 --samples 1 --frames 0:1 --max-frames 2");
+    CHECK(r.status == 0);
+    CHECK(fs::exists(test::temp_dir() + "/lim_frame_0001.png"));
+}

@@ -1,0 +1,91 @@
+// One fuzz input through the whole pipeline, as `sdfc` runs it:
+//   source checks -> parse (+ AST listing) -> interpret -> compile_scene -> batch VM at a
+//   few points (both programs; the distance against the one-instruction-at-a-time
+//   reference), then the GLSL emitter on the scene built with a symbolic time.
+// An input starting with "# vm" is read as a .vm model instead (`#` starts a comment
+// there). The limits are small, so no input can legitimately run long or grow large: a
+// timeout or running out of memory is a finding like a crash, a sanitizer report or a leak.
+// Used by the libFuzzer target (fuzz_pipeline.cpp) and by the replay of the crashers kept
+// in tests/fuzz/regressions/ (tests/lang/test_fuzz_regressions.cpp).
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "compiler/compile.hpp"
+#include "compiler/glsl.hpp"
+#include "lang/ast.hpp"
+#include "lang/interpreter.hpp"
+#include "lang/load.hpp"
+#include "runtime/vm.hpp"
+
+namespace sdfc::fuzz {
+
+// Imports resolve next to a folder that does not exist, so only absolute paths reach files.
+inline const char* const kPath = "/nonexistent/sdfc-fuzz/input.sdf";
+
+inline InterpretOptions options(std::optional<float> time) {
+    InterpretOptions o;
+    o.time = time;
+    Limits& l = o.limits;
+    l.max_recursion = 32;
+    l.max_calls = 20000;
+    l.max_loop_iterations = 10000;
+    l.max_total_iterations = 10000;
+    l.max_shapes = 20000;
+    l.max_ops = 200000;
+    l.max_nesting = 64;
+    l.max_shape_depth = 500;
+    l.max_file_bytes = 1u << 20;
+    return o;
+}
+
+// "" when the VM agrees with the reference evaluation, else what differs.
+inline std::string evaluate(const CompiledScene& cs) {
+    constexpr int n = 6;
+    float x[n] = {0.0f, 1.0f, -3.0f, 1e3f, 0.1f, 2.5f};
+    float y[n] = {0.0f, 0.5f, 2.0f, -1e3f, 1e-7f, -0.25f};
+    float z[n] = {0.0f, -2.0f, 1.0f, 0.0f, -0.3f, 4.0f};
+    Evaluator d(cs.distance);
+    d.eval(x, y, z, n, cs.time);
+    Evaluator s(cs.shading);
+    s.eval(x, y, z, n, cs.time);
+    for (int i = 0; i < n; ++i) {
+        float ref = eval_scalar(cs.distance, x[i], y[i], z[i], cs.time).at(0);
+        float got = d.output(0)[i];
+        bool same = (std::isnan(ref) && std::isnan(got)) || ref == got ||
+                    std::fabs(ref - got) <= 1e-4f * std::max(1.0f, std::fabs(ref));
+        if (!same) return fmt::format("VM and eval_scalar differ at ({}, {}, {}): {} vs {}", x[i], y[i], z[i], got, ref);
+    }
+    return "";
+}
+
+// Runs `text` through the pipeline. A CompileError is the expected outcome of bad input;
+// any other exception propagates. Returns "" or a description of a wrong result.
+inline std::string run(const std::string& text) {
+    const bool vm = text.rfind("# vm", 0) == 0;
+    try {
+        SourceManager sm;
+        const SourceFile& f = sm.add(kPath, text);
+        check_source_text(f);  // what SourceManager::load checks (NUL bytes, UTF-8)
+        if (vm) return evaluate(compile_scene(load_vm(sm, f)));
+        (void)ast::dump(*ast::parse(f, ast::ParseOptions{options(0.0f).limits.max_nesting}));
+        std::string r = evaluate(compile_scene(interpret_source(sm, f, options(0.5f))));
+        if (!r.empty()) return r;
+    } catch (const CompileError& e) {
+        (void)e.formatted();
+        return "";
+    }
+    try {
+        SourceManager sm;
+        const SourceFile& f = sm.add(kPath, text);
+        (void)emit_glsl(interpret_source(sm, f, options(std::nullopt)), GlslTarget::Glsl330);
+    } catch (const CompileError& e) {
+        (void)e.formatted();
+    }
+    return "";
+}
+
+}  // namespace sdfc::fuzz
