@@ -155,6 +155,7 @@ int cmd_render(Args& a) {
     auto threads = a.value("--threads");
     auto view = a.value("--view");
     bool quiet = a.flag("--quiet") || a.flag("-q");
+    bool baseline = a.flag("--baseline");  // hidden: every acceleration off (issue 6)
     // Overrides are read per scene below; take them out of the positionals first.
     std::vector<std::pair<std::string, std::optional<std::string>>> ov;
     for (const char* f : {"--width", "--height", "--samples", "--camera-position", "--camera-target", "--fov"}) ov.emplace_back(f, a.value(f));
@@ -162,6 +163,7 @@ int cmd_render(Args& a) {
     if (scenes.empty()) throw UsageError("render needs a scene file");
     if (!out) throw UsageError("render needs -o OUT");
     RenderOptions ro;
+    ro.baseline = baseline;
     if (threads) ro.threads = Args::to_int("--threads", *threads, 1, 1024);
     if (aov) {
         std::stringstream ss(*aov);
@@ -210,9 +212,25 @@ int cmd_render(Args& a) {
             Args overrides(flat);
             apply_overrides(cs, overrides, c);
             std::string target = expand(*out, f, name);
+            // A progress bar with ETA on a terminal, for renders past a second; the summary
+            // line below either way (unless --quiet).
+            bool bar = false;
+            if (!quiet && isatty(fileno(stderr))) {
+                ro.progress = [&](const RenderProgress& p) {
+                    if (p.tiles_done >= p.tiles_total || p.elapsed_s < 1.0 || p.tiles_total <= 0) return;
+                    const double frac = double(p.tiles_done) / double(p.tiles_total);
+                    const double eta = frac > 0 ? p.elapsed_s * (1.0 - frac) / frac : 0.0;
+                    const int width = 30, fill = std::clamp(int(frac * width), 0, width);
+                    std::fprintf(stderr, "\r\033[Ksdfc: %s [%s%s] %3d%%  %.1f s, ETA %.1f s", target.c_str(),
+                                 std::string(size_t(fill), '#').c_str(), std::string(size_t(width - fill), '.').c_str(),
+                                 int(frac * 100.0), p.elapsed_s, eta);
+                    bar = true;
+                };
+            }
             auto t0 = std::chrono::steady_clock::now();
-            Image img = cs.is_2d ? render_2d(cs, cs.render.width, cs.render.height, ro.threads) : render(cs, ro);
+            Image img = cs.is_2d ? render_2d(cs, cs.render.width, cs.render.height, ro.threads, baseline) : render(cs, ro);
             double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            if (bar) std::fputs("\r\033[K", stderr);
             write_image(target, img);
             if (!quiet) std::fprintf(stderr, "sdfc: wrote %s (%dx%d, %.1f ms)\n", target.c_str(), img.width, img.height, ms);
         }
@@ -379,7 +397,7 @@ int cmd_bench(Args& a) {
     apply_overrides(cs, overrides, c);
     RenderOptions ro;
     if (threads) ro.threads = Args::to_int("--threads", *threads, 1, 1024);
-    (void)baseline;  // TODO(issue 6): RenderOptions::baseline
+    ro.baseline = baseline;
     std::vector<double> ms;
     RenderStats stats;
     for (int i = 0; i < n; ++i) {
@@ -394,8 +412,15 @@ int cmd_bench(Args& a) {
     std::sort(sorted.begin(), sorted.end());
     double median = sorted.size() % 2 ? sorted[sorted.size() / 2] : 0.5 * (sorted[sorted.size() / 2 - 1] + sorted[sorted.size() / 2]);
     double pixels = double(cs.render.width) * cs.render.height;
-    double evals = double(stats.distance_points + stats.shading_points) / pixels;
-    std::printf("median_ms=%.3f min_ms=%.3f evals_per_pixel=%.2f\n", median, sorted.front(), evals);
+    // SDF evaluations (the distance program) per pixel, then what they were for, and the
+    // material (shading program) evaluations.
+    auto per = [&](uint64_t v) { return double(v) / pixels; };
+    const auto& by = stats.distance_points_by;
+    std::printf("median_ms=%.3f min_ms=%.3f evals_per_pixel=%.2f rays=%.2f normals=%.2f shadows=%.2f ao=%.2f "
+                "shading=%.2f tree_leaves=%llu tree_ms=%.1f\n",
+                median, sorted.front(), per(stats.distance_points), per(by[RenderStats::kRays]),
+                per(by[RenderStats::kNormals]), per(by[RenderStats::kShadows]), per(by[RenderStats::kAo]),
+                per(stats.shading_points), static_cast<unsigned long long>(stats.tree_leaves), stats.tree_ms);
     return 0;
 }
 

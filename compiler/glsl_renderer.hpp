@@ -164,25 +164,31 @@ void sdf_clip_ray(vec3 o, vec3 d, inout float t_min, inout float t_max) {
 // The marching rules, one distance value at a time (the tracer below owns the only map()
 // call, see sdf_trace). Each returns true when its march is over.
 
-// Over-relaxed sphere tracing (Keinert et al. 2014: omega = 1.5, back to 1 when consecutive
-// unbounding spheres stop overlapping) on the signed value s at t. A hit is s < epsilon *
-// max(path, 1), or, out of steps, s within one pixel footprint. `strict`: shadow rays end
-// at t >= tmax (camera and bounce rays at t > tmax).
+// Over-relaxed sphere tracing (Keinert et al. 2014: omega = 1.5, back to the previous
+// sphere's boundary and omega = 1 when consecutive unbounding spheres stop overlapping or
+// the step went through the surface; plain steps within 8 hit thresholds of a surface) on
+// the signed value s at t. A hit is s < epsilon * max(path, 1), or, out of steps, s within
+// one pixel footprint; a hit moves on by its last s (still outside: 1-Lipschitz).
+// `strict`: shadow rays, which end at t >= tmax (camera and bounce rays at t > tmax).
+// The same rules as runtime/tracer.cpp's march() and shadow_hard().
 bool sdf_relaxed_step(float s, float t0, float tmax, bool strict, int steps, inout float t, inout float om, inout float pr,
                       inout float sl, out bool hit) {
     float r = abs(s);
-    bool fail = om > 1.0 && r + pr < sl;
-    float step = fail ? (1.0 - om) * sl : om * s;
+    float thr = SDF_EPSILON * max(t0 + t, 1.0);
+    bool fail = om > 1.0 && sl > pr && (r + pr < sl || (!strict && s < 0.0));
+    float w = s > 8.0 * thr ? om : 1.0;
+    float step = fail ? pr - sl : w * s;
     om = fail ? 1.0 : om;
     sl = step;
     pr = r;
-    bool stop = (s < SDF_EPSILON * max(t0 + t, 1.0) && !fail) || steps >= SDF_MAX_STEPS;
+    bool stop = (s < thr && !fail) || steps >= SDF_MAX_STEPS;
     float tn = t + step;
     bool past = strict ? !(tn < tmax) : !(tn <= tmax);
     float last = fail ? sdf_inf() : s;
     t = stop ? t : tn;
     float path = t0 + t;
     hit = last < sdf_thr(path) || (steps >= SDF_MAX_STEPS && last < sdf_footprint(path));
+    if (hit && !strict && last > 0.0) t += last;
     return stop || past;
 }
 
@@ -233,16 +239,27 @@ bool sdf_raw_step(float s, float t0, float tmax, bool shadow, int steps, inout f
 }
 
 // Soft shadows: Quilez's penumbra estimate with the closest-approach refinement (h and the
-// previous positive h), marching through occluders; res is the smallest cone fraction.
-bool sdf_soft_step(float h, float t0, float tmax, float w, int steps, inout float t, inout float res, inout float prev) {
+// previous positive h; y = (s^2 + h^2 - b^2) / 2s after a step s longer than the previous
+// h = b), marching through occluders; res is the smallest cone fraction. Over-relaxed like
+// sdf_relaxed_step, only where h >= 4 cone widths and 8 hit thresholds (no sample is taken
+// after a failed relaxed step). The same rules as runtime/tracer.cpp's shadow_soft().
+bool sdf_soft_step(float h, float t0, float tmax, float w, int steps, inout float t, inout float res, inout float prev,
+                   inout float om, inout float pr, inout float sl) {
     float thr = SDF_EPSILON * max(t0 + t, 1.0);
     bool pos = h > 0.0;
-    float y = min(h * h / (2.0 * prev), 0.999 * h);
+    float r = abs(h);
+    bool fail = om > 1.0 && sl > pr && (r + pr < sl || !pos);
+    float y0 = sl > prev && prev < 1e19 ? (sl * sl + h * h - prev * prev) / (2.0 * sl) : h * h / (2.0 * prev);
+    float y = min(max(y0, 0.0), 0.999 * h);
     float dd = sqrt(max(h * h - y * y, 0.0));
     float est = pos ? dd / (w * max(t - y, 1e-20)) : h / (w * max(t, 1e-20));
-    res = est < res ? est : res;  // NaN keeps res
-    prev = pos ? h : 1e20;
-    float step = pos ? max(h, thr) : max(0.25 * w * t, thr);
+    res = (est < res && !fail) ? est : res;  // NaN keeps res
+    prev = fail ? prev : (pos ? h : 1e20);
+    bool far = pos && h > 4.0 * w * t && h > 8.0 * thr;
+    float step = fail ? pr - sl : (pos ? max((far ? om : 1.0) * h, thr) : max(0.25 * w * t, thr));
+    om = fail ? 1.0 : om;
+    sl = step;
+    pr = r;
     t = t + step;
     return isnan(h) || res <= -1.0 || steps >= SDF_MAX_STEPS || !(t < tmax);
 }
@@ -597,7 +614,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
         } else {  // SDF_ST_SHADOW
             bool hit = false, done;
             if (SDF_RAW) done = sdf_raw_step(dist, path, stmax, true, steps, t, prev, lo, hi, bisect, hit);
-            else if (soft) done = sdf_soft_step(dist, path, stmax, sw, steps, t, res, prev);
+            else if (soft) done = sdf_soft_step(dist, path, stmax, sw, steps, t, res, prev, om, pr, sl);
             else done = sdf_relaxed_step(dist, path, stmax, true, steps, t, om, pr, sl, hit);
             if (done) {
                 float vis = soft ? sdf_penumbra(res) : (hit ? 0.0 : 1.0);

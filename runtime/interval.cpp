@@ -701,12 +701,13 @@ void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint
     s.len.fill(0);
     s.out.fill(0);
     s.cap = n;
-    if (s.buf_size < 64 * n) {
-        s.buf.reset(static_cast<Instr*>(::operator new(sizeof(Instr) * 64 * n)));
-        s.buf_size = 64 * n;
+    if (lanes == 0) return;
+    const size_t blocks = size_t(64 - __builtin_clzll(lanes));  // lanes 0 .. the highest one used
+    if (s.buf_size < blocks * n) {
+        s.buf.reset(static_cast<Instr*>(::operator new(sizeof(Instr) * blocks * n)));
+        s.buf_size = blocks * n;
     }
     Instr* buf = s.buf.get();
-    if (lanes == 0) return;
     if (!parent.linked || parent.out_def == Tape::kNone) {
         for (uint64_t m = lanes; m; m &= m - 1) {
             const int j = __builtin_ctzll(m);
@@ -792,9 +793,9 @@ void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint
         return;
     }
     // Forwards: each lane's live instructions, as parent indices in order.
-    if (s.idx_size < 64 * n) {
-        s.idx.reset(new uint32_t[64 * n]);
-        s.idx_size = 64 * n;
+    if (s.idx_size < blocks * n) {
+        s.idx.reset(new uint32_t[blocks * n]);
+        s.idx_size = blocks * n;
     }
     uint32_t* idx = s.idx.get();
     std::array<uint32_t, 64> cnt{};

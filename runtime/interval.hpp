@@ -5,8 +5,8 @@
 // simplify() then drops the losing sides and everything only they used, and re-allocates
 // registers, giving a shorter tape that computes exactly the same values inside the box.
 //
-// Unknown: an interval with a NaN end means "some point may be NaN" (or an input was
-// infinite); it never decides a choice and propagates through every op.
+// Unknown: an interval with both ends NaN means "some point may be NaN" (or an operand was
+// infinite); it never decides a choice and propagates through every op (see interval.cpp).
 #pragma once
 #include <cstdint>
 #include <array>
@@ -74,7 +74,8 @@ public:
               const float* zhi, int n, float time = 0.0f);
 
     Interval result(int lane) const { return {lo_[out_ * kIvLanes + lane], hi_[out_ * kIvLanes + lane]}; }
-    // Choice of slot s for lane i: choices()[s * stride() + i].
+    // Choice of slot s for lane i: choices()[s * stride() + i] (stride: n rounded up to 8;
+    // the buffer has 64 readable bytes past the last slot's row).
     const uint8_t* choices() const { return choices_.get(); }
     int stride() const { return stride_; }
 
@@ -93,7 +94,6 @@ struct SimplifyScratch {
     std::vector<uint16_t> bind;     // per parent instruction: register of its value (when live)
     std::vector<uint16_t> free_regs;
     std::vector<Instr> rev;         // emitted instructions, last first
-    std::vector<uint32_t> last_def; // link(): per register
 };
 
 // The tape `parent` (linked) shortened for one box: the choices of `lane` (from an
@@ -123,7 +123,8 @@ struct BatchScratch {
 // lane's box. One backward pass over the parent finds every lane's live instructions (64
 // lanes at once, as bit masks, following only the winners of decided choices). Then
 //   compact: each lane's short list alone is register-allocated, decided choices vanish
-//            (the winner takes over the register): the same tapes as simplify();
+//            (the winner takes over the register; a copy only if the winner is also
+//            used elsewhere): as short as simplify()'s tapes;
 //   else:    a trace: the live instructions in the parent's registers, a decided choice
 //            op replaced by a copy of its winner (nothing if already in place) or by a
 //            constant. Cheaper to make, a little longer: for tapes evaluated once

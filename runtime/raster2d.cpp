@@ -296,7 +296,7 @@ Image render_2d(const CompiledScene& scene, int w, int h, int threads, bool base
             }
             points += uint64_t(r.size()) * uint64_t(w);
         });
-        if (stats) stats->distance_points = points;
+        if (stats) stats->distance_points = stats->distance_points_by[RenderStats::kRays] = points;
         return img;
     }
 
@@ -326,7 +326,7 @@ Image render_2d(const CompiledScene& scene, int w, int h, int threads, bool base
     if (c.sizes.size() > 1) descend(c, *s, 0, top);
     else process(c, *s, 0, root, 0, 0);
     pool->release(s);
-    if (stats) stats->distance_points = pool->points();
+    if (stats) stats->distance_points = stats->distance_points_by[RenderStats::kRays] = pool->points();
     return img;
 }
 
