@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
                 diff.at(x, y, c) = std::min(1.0f, float(std::abs(d)) * 8.0f / 255.0f);
             }
             off += worst > 8;
+            if (worst > 64 && std::getenv("SDFC_PSNR_LIST")) std::printf("pixel %d %d off by %d\n", x, y, worst);
         }
     if (se == 0) std::printf("psnr=inf pixels_off=0\n");
     else std::printf("psnr=%.2f pixels_off=%zu\n", 10.0 * std::log10(255.0 * 255.0 / (se / double(n))), off);

@@ -176,7 +176,8 @@ bool sdf_relaxed_step(float s, float t0, float tmax, bool strict, int steps, ino
     float r = abs(s);
     float thr = SDF_EPSILON * max(t0 + t, 1.0);
     bool fail = om > 1.0 && sl > pr && (r + pr < sl || (!strict && s < 0.0));
-    float w = s > 8.0 * thr ? om : 1.0;
+    float tr = t + om * s;  // a relaxed step past tmax is not taken: only a plain step may end the ray
+    float w = (s > 8.0 * thr && (strict ? tr < tmax : tr <= tmax)) ? om : 1.0;
     float step = fail ? pr - sl : w * s;
     om = fail ? 1.0 : om;
     sl = step;
@@ -255,7 +256,7 @@ bool sdf_soft_step(float h, float t0, float tmax, float w, int steps, inout floa
     float est = pos ? dd / (w * max(t - y, 1e-20)) : h / (w * max(t, 1e-20));
     res = (est < res && !fail) ? est : res;  // NaN keeps res
     prev = fail ? prev : (pos ? h : 1e20);
-    bool far = pos && h > 4.0 * w * t && h > 8.0 * thr;
+    bool far = pos && h > 4.0 * w * t && h > 8.0 * thr && t + om * h < tmax;
     float step = fail ? pr - sl : (pos ? max((far ? om : 1.0) * h, thr) : max(0.25 * w * t, thr));
     om = fail ? 1.0 : om;
     sl = step;
@@ -446,7 +447,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
                 float bias = sdf_bias(P, path);
                 so = P + Nf * bias;
                 sdir = L;
-                float a0 = 0.0;
+                float a0 = bias;  // (as runtime/tracer.cpp: edges do not shadow themselves)
                 stmax = light.directional ? SDF_MAX_DIST : max(dist - bias, 0.0);
                 sdf_clip_ray(so, sdir, a0, stmax);
                 if (!(a0 <= stmax)) {  // the segment never enters the scene's box

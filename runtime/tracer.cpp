@@ -519,6 +519,7 @@ struct Frame {
     RenderView view = RenderView::Shaded;
     glm::vec3 ambient{0}, background{0};
     float relax = kRelax;           // over-relaxation factor (1 = plain Hart)
+    bool premarch = true;           // tile cone pre-marching (Worker::tile_start)
     TapeTree tree;                  // leaf 0 (the full distance program) at least
     Program regs;                   // no code: sizes the workers' distance register files
     std::vector<Instr> shade_code;  // the shading program without the distance output's code
@@ -862,8 +863,10 @@ private:
         return true;
     }
 
-    void push_primary(RaySet& rs, const Ray& r, float weight, uint32_t prim) {
-        float tmin = 0.0f, tmax = f_.max_dist;
+    float tile_start(int x0, int y0, int x1, int y1);
+
+    void push_primary(RaySet& rs, const Ray& r, float weight, uint32_t prim, float start) {
+        float tmin = start, tmax = f_.max_dist;
         f_.clip_ray(r.origin, r.dir, tmin, tmax);
         rs.push(r.origin, r.dir, tmin, tmax, 0.0f, glm::vec3(weight), prim, false);
     }
@@ -912,7 +915,8 @@ void Worker::march(const RaySet& rs) {
                 // plain sphere tracing samples them and hit or miss alike.
                 const float thr = eps * std::max(L.t0[i] + L.t[i], 1.0f);
                 const bool fail = (L.om[i] > 1.0f) & (L.sl[i] > L.pr[i]) & ((r + L.pr[i] < L.sl[i]) | (s < 0.0f));
-                const float om = s > kRelaxNear * thr ? L.om[i] : 1.0f;
+                // (A relaxed step past tmax is not taken: only a plain step may end the ray.)
+                const float om = (s > kRelaxNear * thr) & (L.t[i] + L.om[i] * s <= L.tmax[i]) ? L.om[i] : 1.0f;
                 const float step = fail ? L.pr[i] - L.sl[i] : om * s;
                 L.om[i] = fail ? 1.0f : L.om[i];
                 L.sl[i] = step;
@@ -1181,7 +1185,7 @@ void Worker::shadow_hard(const RaySet& rs) {
                 const float r = std::fabs(d[i]);
                 const float thr = eps * std::max(L.t0[i] + L.t[i], 1.0f);
                 const bool fail = (L.om[i] > 1.0f) & (L.sl[i] > L.pr[i]) & (r + L.pr[i] < L.sl[i]);
-                const float om = d[i] > kRelaxNear * thr ? L.om[i] : 1.0f;
+                const float om = (d[i] > kRelaxNear * thr) & (L.t[i] + L.om[i] * d[i] < L.tmax[i]) ? L.om[i] : 1.0f;
                 const float step = fail ? L.pr[i] - L.sl[i] : om * d[i];
                 L.om[i] = fail ? 1.0f : L.om[i];
                 L.sl[i] = step;
@@ -1240,7 +1244,7 @@ void Worker::shadow_soft(const RaySet& rs) {
                 L.a[i] = res;
                 L.b[i] = fail ? L.b[i] : (pos ? h : 1e20f);
                 // Sphere tracing outside; through an occluder in steps of a quarter cone width.
-                const bool far = pos & (h > kSoftRelaxFar * w * t) & (h > kRelaxNear * thr);
+                const bool far = pos & (h > kSoftRelaxFar * w * t) & (h > kRelaxNear * thr) & (t + L.om[i] * h < L.tmax[i]);
                 const float om = far ? L.om[i] : 1.0f;
                 const float step = fail ? L.pr[i] - L.sl[i] : pos ? std::max(om * h, thr) : std::max(0.25f * w * t, thr);
                 L.om[i] = fail ? 1.0f : L.om[i];
@@ -1411,8 +1415,11 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
                 continue;
             }
             const float bias = f_.bias(P, h.t0[i]);
+            // Off the surface along the normal, and the march begins one more bias along the
+            // light: at edges (where the normal blends two faces) a start closer than that
+            // is in the other face's hit band, which would shadow the edge by chance.
             const glm::vec3 o = P + N * bias;
-            float tmin = 0.0f, tmax = light.directional ? f_.max_dist : std::max(dist - bias, 0.0f);
+            float tmin = bias, tmax = light.directional ? f_.max_dist : std::max(dist - bias, 0.0f);
             f_.clip_ray(o, L, tmin, tmax);
             if (!(tmin <= tmax)) {
                 add(h.prim[i], c);  // the segment never enters the scene's bounds
@@ -1434,6 +1441,36 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
     }
 }
 
+// Tile cone pre-marching: one march along the tile's central ray for all its primary rays.
+// Every ray of the tile (directions within the corners' cone, origins within the corners')
+// stays within R(t) = r0 + t * r1 of the axis point at the same t, so when the axis has
+// distance d at t, the ball of radius d around it holds every ray's points up to t + step
+// for step = d - R(t) - thr(t + d): no surface there, nor any point where plain tracing
+// would stop (d >= its hit threshold). The rays then start at the final t.
+float Worker::tile_start(int x0, int y0, int x1, int y1) {
+    const Ray c = f_.camera.ray(0.5f * static_cast<float>(x0 + x1), 0.5f * static_cast<float>(y0 + y1));
+    float r0 = 0.0f, r1 = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+        const Ray q = f_.camera.ray(static_cast<float>(k & 1 ? x1 : x0), static_cast<float>(k & 2 ? y1 : y0));
+        r0 = std::max(r0, glm::length(q.origin - c.origin));
+        r1 = std::max(r1, glm::length(q.dir - c.dir));
+    }
+    r0 = r0 * 1.01f + 1e-6f, r1 = r1 * 1.01f + 1e-6f;  // rounding margin
+    float t = 0.0f, tmax = f_.max_dist;
+    f_.clip_ray(c.origin, c.dir, t, tmax);  // (not the start: other rays may enter the box sooner)
+    t = 0.0f;
+    constexpr int kMaxConeSteps = 32;
+    for (int i = 0; i < kMaxConeSteps && t < f_.max_dist; ++i) {
+        const glm::vec3 p = c.origin + c.dir * t;
+        float d;
+        eval_points(&p.x, &p.y, &p.z, 1, &d);
+        const float step = d - (r0 + r1 * t) - f_.thr(t + d);
+        if (!(step > 1e-3f * std::max(t, 1.0f))) break;  // also NaN
+        t += step;
+    }
+    return t;
+}
+
 void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* depth, AovPlane* normal, AovPlane* steps) {
     const int tw = x1 - x0, th = y1 - y0;
     const int S = f_.samples;
@@ -1447,12 +1484,13 @@ void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* d
     const glm::vec3 bg = f_.background;
 
     rays_.clear();
+    const float start = f_.premarch ? tile_start(x0, y0, x1, y1) : 0.0f;
     for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
             const uint32_t pix = static_cast<uint32_t>((y - y0) * tw + (x - x0));
             for (int s = 0; s < S; ++s) {
                 const glm::vec2 o = f_.offsets[s];
-                push_primary(rays_, f_.camera.ray(static_cast<float>(x) + o.x, static_cast<float>(y) + o.y), w0, pix * S + s);
+                push_primary(rays_, f_.camera.ray(static_cast<float>(x) + o.x, static_cast<float>(y) + o.y), w0, pix * S + s, start);
             }
         }
     stats.primary_rays += nprim;
@@ -1660,8 +1698,10 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
 
     // Acceleration: over-relaxation, clipping to the bounds (a raw field needs its box
     // anyway: it is where it is marched) and the tape tree (built below, in the arena).
+    f.premarch = !f.raw && !f.cone;
     if (options.baseline) {
         f.relax = 1.0f;
+        f.premarch = false;
         if (!f.raw) f.clip = false;
     }
     f.tree.init_full(scene.distance);

@@ -114,19 +114,21 @@ for (i = [0:5]) translate([-2.5 + i, 0.2, 1.5]) sphere(0.2);
 }
 
 TEST_CASE("accel: the examples match the baseline", "[accel][examples]") {
-    for (const char* name : {"three-tori", "csg-tori", "seasquid", "recursive1", "lattice", "gyroid-ball"}) {
+    // At a quarter of the benchmark's 640 x 360, with each example's own samples (at most 2):
+    // with one sample, pixels at box edges and grazing rays are coin flips that differ
+    // between any two ways of stepping (the hit point moves within the hit threshold, and
+    // an edge's normal blends its faces), so single-sample PSNR says little.
+    for (const char* name : {"three-tori", "csg-tori", "seasquid", "recursive1", "lattice", "gyroid-ball", "showcase"}) {
         SourceManager sm;
         const std::string path = std::string(SDFC_SOURCE_DIR) + "/examples/" + name + ".sdf";
         CompiledScene cs = compile_scene(load_scene(sm, path));
-        cs.render.width = 96;
-        cs.render.height = 54;
-        cs.render.samples = 1;
+        cs.render.width = 320;
+        cs.render.height = 180;
+        cs.render.samples = std::min(cs.render.samples, 2);
         const Pair p = render_both(cs);
         INFO(name << ": psnr " << psnr(p.accel, p.base));
-        // The lattice's thin struts: whether a ray grazing one within the hit threshold stops
-        // depends on where its march began (the bounds clip) and how it stepped; one sample
-        // per pixel leaves those silhouette pixels unblended (measured 44.2 dB).
-        CHECK(psnr(p.accel, p.base) >= (std::string(name) == "lattice" ? 42.0 : 45.0));
+        CHECK(psnr(p.accel, p.base) >= 45.0);
+        CHECK(p.sa.distance_points < p.sb.distance_points);
     }
 }
 
