@@ -44,7 +44,10 @@ usage:
   sdfc check   SCENE
   sdfc eval    SCENE (--at X,Y,Z | --points FILE) [--time T]
   sdfc slice   SCENE --axis x|y|z --at V -o OUT [--range UMIN,UMAX,VMIN,VMAX] [--width W] [--height H]
-  sdfc bench   SCENE [--width W] [--height H] [--repeat N] [--threads N] [--baseline]
+  sdfc bench   SCENE [--width W] [--height H] [--samples N] [--repeat N] [--threads N] [--baseline]
+              prints median_ms, min_ms, evals_per_pixel (SDF evaluations: rays, normals,
+              shadows, ao), shading (material evaluations), the mean program length run
+              (tape=MEAN/FULL) and the tape tree; --baseline: plain Hart sphere tracing
   sdfc --help | --version | CMD --help
 
 SCENE is a .sdf script or a .vm model (Prospero/Fidget flat SSA format).
@@ -385,7 +388,7 @@ int cmd_bench(Args& a) {
     auto threads = a.value("--threads");
     bool baseline = a.flag("--baseline");
     std::vector<std::pair<std::string, std::optional<std::string>>> ov;
-    for (const char* f : {"--width", "--height"}) ov.emplace_back(f, a.value(f));
+    for (const char* f : {"--width", "--height", "--samples"}) ov.emplace_back(f, a.value(f));
     std::string path = one_scene(a, "bench");
     int n = repeat ? Args::to_int("--repeat", *repeat, 1, 100000) : 5;
     SourceManager sm;
@@ -417,10 +420,12 @@ int cmd_bench(Args& a) {
     auto per = [&](uint64_t v) { return double(v) / pixels; };
     const auto& by = stats.distance_points_by;
     std::printf("median_ms=%.3f min_ms=%.3f evals_per_pixel=%.2f rays=%.2f normals=%.2f shadows=%.2f ao=%.2f "
-                "shading=%.2f tree_leaves=%llu tree_ms=%.1f\n",
+                "shading=%.2f tape=%.0f/%zu tree_leaves=%llu tree_ms=%.1f\n",
                 median, sorted.front(), per(stats.distance_points), per(by[RenderStats::kRays]),
                 per(by[RenderStats::kNormals]), per(by[RenderStats::kShadows]), per(by[RenderStats::kAo]),
-                per(stats.shading_points), static_cast<unsigned long long>(stats.tree_leaves), stats.tree_ms);
+                per(stats.shading_points),
+                stats.distance_points ? double(stats.distance_instructions) / double(stats.distance_points) : 0.0,
+                cs.distance.code.size(), static_cast<unsigned long long>(stats.tree_leaves), stats.tree_ms);
     return 0;
 }
 

@@ -4,7 +4,9 @@
 // their bound first, so one distorting modifier does not make the whole scene conservative.
 #include "compiler/lower.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <numbers>
 
 namespace sdfc {
@@ -501,9 +503,55 @@ NodeId stairs_union(L& l, NodeId a, NodeId b, NodeId r, NodeId n) {
     return l.mn(l.mn(a, b), l.mul(l.c(0.5f), l.add(l.add(u, a), l.abs(l.sub(m, s)))));
 }
 
+// A plain union of many bounded shapes, as a balanced tree of min() over the children in
+// space order (recursive median splits of their bounds' centres on the widest axis: a k-d
+// tree). The same distance as the script's chain (min is exact and associative), but over
+// a box, interval arithmetic (runtime/interval.hpp) decides a whole far subtree at its
+// root, so the tracer's per-cell programs keep only the shapes near the cell: with a chain
+// in script order (say a for loop over a grid) the running minimum approaches a box a
+// little at a time and every shape about as far as it stays. Measured on a 100 x 100 grid
+// of spheres, a 0.5-unit box keeps 502 of 30,203 instructions instead of 4,857. With an
+// unbounded child (a floor plane) the chain stays: the plane's bound, first in the chain,
+// prunes far shapes at once, which no inner node of a tree would see (measured: worse
+// tapes on examples/showcase.sdf). Ties between equally near shapes may pick another
+// child's material than the chain would. Returns nothing to keep the chain.
+constexpr size_t kSpatialUnion = 8;
+
+std::optional<Lowered> lower_union_spatial(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    Graph& g = l.g;
+    std::vector<glm::vec3> centre(s.children.size());
+    for (size_t i = 0; i < s.children.size(); ++i) {
+        const Bounds b = shape_bounds(g, *s.children[i]);
+        if (!(b.finite() && b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) return std::nullopt;
+        centre[i] = 0.5f * (b.lo + b.hi);
+    }
+    std::vector<uint32_t> order(s.children.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<uint32_t>(i);
+    auto build = [&](auto&& self, uint32_t* first, uint32_t* last) -> Lowered {
+        if (last - first == 1) {
+            Lowered c = lower_shape(g, *s.children[*first], p, inherited);
+            return Lowered{unit(g, c), 1.0f, c.m};
+        }
+        glm::vec3 lo(INFINITY), hi(-INFINITY);
+        for (const uint32_t* i = first; i != last; ++i) lo = glm::min(lo, centre[*i]), hi = glm::max(hi, centre[*i]);
+        const glm::vec3 ext = hi - lo;
+        const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+        // Deterministic: ties in a coordinate keep the children's order.
+        std::stable_sort(first, last, [&](uint32_t a, uint32_t b) { return centre[a][axis] < centre[b][axis]; });
+        uint32_t* mid = first + (last - first) / 2;
+        const Lowered a = self(self, first, mid), b = self(self, mid, last);
+        Lowered r{l.mn(a.d, b.d), 1.0f, {}};
+        if (inherited) r.m = select_mat(g, l.lt(a.d, b.d), a.m, b.m);
+        return r;
+    };
+    return build(build, order.data(), order.data() + order.size());
+}
+
 Lowered lower_csg(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
     Graph& g = l.g;
     if (s.children.empty()) return Lowered{l.c(1e20f), 1.0f, inherited ? *inherited : MaterialN{}};
+    if (s.kind == ShapeKind::Union && s.children.size() >= kSpatialUnion)
+        if (std::optional<Lowered> t = lower_union_spatial(l, s, p, inherited)) return *t;
     Lowered acc = lower_shape(g, *s.children[0], p, inherited);
     acc.d = unit(g, acc);
     acc.lip = 1.0f;

@@ -83,6 +83,7 @@ const std::vector<std::string>& known_aovs() {
 }
 
 namespace {
+struct Dbg { std::atomic<uint64_t> pts[2][4]{}, ins[2][4]{}; ~Dbg() { if (getenv("DBG")) for (int z = 0; z < 2; ++z) for (int k = 0; k < 4; ++k) fprintf(stderr, "leaf0=%d kind=%d points=%lu instr=%lu\n", z, k, (unsigned long)pts[z][k], (unsigned long)ins[z][k]); } } g_dbg;
 
 constexpr int kConeEvents = 4;
 constexpr int kAoTaps = 5;
@@ -164,7 +165,7 @@ float schlick(float cos_theta, float ior) {
 constexpr int kTreeMaxDepth = 16;
 constexpr size_t kTreeLeafTape = 64;      // tapes this short are not split further
 constexpr size_t kTreeMinProgram = 256;   // shorter programs get no tree (lookups would cost more)
-constexpr size_t kTreePilot = 8;          // after splits worth this many programs ...
+constexpr size_t kTreePilot = 32;          // after splits worth this many programs ...
 constexpr double kTreeUseless = 0.6;      // ... surface cells' tapes this long: no tree
 constexpr size_t kTreeMaxNodes = size_t(1) << 20;
 constexpr int kTreeMaxStall = 3;          // splits in a row that did not shorten tapes (x 0.9)
@@ -681,6 +682,7 @@ private:
         }
         stats.distance_points += static_cast<uint64_t>(n);
         stats.distance_points_by[kind_] += static_cast<uint64_t>(n);
+        g_dbg.pts[id == 0][kind_] += n; g_dbg.ins[id == 0][kind_] += uint64_t(n) * lf.len;
         stats.distance_instructions += static_cast<uint64_t>(n) * lf.len;
     }
 
@@ -705,6 +707,7 @@ private:
             const uint64_t cnt = static_cast<uint64_t>(B.start[b + 1] - B.start[b]);
             stats.distance_points += cnt;
             stats.distance_points_by[kind_] += cnt;
+            g_dbg.pts[B.key_of[b] == 0][kind_] += cnt; g_dbg.ins[B.key_of[b] == 0][kind_] += cnt * lf.len;
             stats.distance_instructions += cnt * lf.len;
         }
     }

@@ -1,6 +1,7 @@
 // The sdfc command end to end (LANGUAGE.md section 10).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "run.hpp"
@@ -115,4 +116,36 @@ TEST_CASE("slice writes a cross-section picture") {
     REQUIRE(fs::exists(out));
     Image img = read_image(out);
     CHECK(img.width == 200);
+}
+
+namespace {
+// The value of `key=` in a bench result line.
+double field(const std::string& line, const std::string& key) {
+    const size_t at = line.find(" " + key + "=") != std::string::npos ? line.find(" " + key + "=") + 1 : line.rfind(key + "=", 0);
+    REQUIRE(at != std::string::npos);
+    return std::stod(line.substr(at + key.size() + 1));
+}
+}  // namespace
+
+TEST_CASE("bench prints one line of times and evaluations; --baseline evaluates more") {
+    const std::string scene = test::example("three-tori.sdf");
+    auto fast = run_sdfc("bench '" + scene + "' --width 96 --height 54 --samples 1 --repeat 2 --threads 2");
+    REQUIRE(fast.status == 0);
+    INFO(fast.out);
+    CHECK(fast.out.rfind("median_ms=", 0) == 0);
+    CHECK(std::count(fast.out.begin(), fast.out.end(), '\n') == 1);
+    for (const char* k : {"min_ms", "evals_per_pixel", "rays", "normals", "shadows", "ao", "shading", "tree_leaves"})
+        CHECK(field(fast.out, k) >= 0.0);
+    // The kinds add up to the SDF evaluations.
+    const double sum = field(fast.out, "rays") + field(fast.out, "normals") + field(fast.out, "shadows") + field(fast.out, "ao");
+    CHECK(sum == Approx(field(fast.out, "evals_per_pixel")).margin(0.03));
+    auto base = run_sdfc("bench '" + scene + "' --width 96 --height 54 --samples 1 --repeat 1 --baseline");
+    REQUIRE(base.status == 0);
+    CHECK(field(base.out, "rays") > field(fast.out, "rays"));
+    // Normals are four taps per hit either way: (nearly) the same hits.
+    CHECK(field(base.out, "normals") == Approx(field(fast.out, "normals")).epsilon(0.02));
+    // --samples multiplies the camera rays.
+    auto s4 = run_sdfc("bench '" + scene + "' --width 96 --height 54 --samples 4 --repeat 1");
+    REQUIRE(s4.status == 0);
+    CHECK(field(s4.out, "rays") > 3.0 * field(fast.out, "rays"));
 }
