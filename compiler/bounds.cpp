@@ -171,4 +171,31 @@ Bounds shape_bounds(const Graph& g, const Shape& s) {
     return infinite();
 }
 
+bool clip_regions(const Graph& g, const Shape& s, Bounds& box, std::vector<glm::vec4>& half_spaces) {
+    check_stack(s.loc);
+    switch (s.kind) {
+        case ShapeKind::Union:
+            for (const auto& c : s.children)
+                if (!clip_regions(g, *c, box, half_spaces)) return false;
+            return true;
+        case ShapeKind::Material: return s.children.empty() || clip_regions(g, *s.children[0], box, half_spaces);
+        case ShapeKind::Plane: {
+            for (NodeId n : s.params)
+                if (!g.is_const(n)) return false;
+            const glm::vec3 n(g.const_value(s.params[0]), g.const_value(s.params[1]), g.const_value(s.params[2]));
+            const float len = glm::length(n), h = g.const_value(s.params[3]);
+            if (!(len > 0.0f) || !std::isfinite(len) || !std::isfinite(h)) return false;
+            half_spaces.emplace_back(n / len, h);
+            return true;
+        }
+        default: {
+            const Bounds b = shape_bounds(g, s);
+            if (is_empty(b)) return true;
+            if (!b.finite()) return false;
+            box = join(box, b);
+            return true;
+        }
+    }
+}
+
 }  // namespace sdfc

@@ -117,6 +117,14 @@ CompiledScene compile_scene(const Scene& scene) {
     cs.background = constant3(g, scene.background, c.loc, "the background color");
     cs.render = scene.render;
     cs.bounds = shape_bounds(g, *scene.root);
+    if (!cs.bounds.finite() && !scene.raw_field) {
+        Bounds box{glm::vec3(1e30f), glm::vec3(-1e30f)};
+        std::vector<glm::vec4> half_spaces;
+        if (clip_regions(g, *scene.root, box, half_spaces) && !half_spaces.empty()) {
+            cs.solid_bounds = box;
+            cs.half_spaces = std::move(half_spaces);
+        }
+    }
     cs.is_2d = scene.is_2d;
     cs.raw_field = scene.raw_field;
     cs.time = scene.time;

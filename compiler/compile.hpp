@@ -41,6 +41,11 @@ struct CompiledScene {
     glm::vec3 ambient{0.05f}, background{0.0f};
     RenderSettings render;
     Bounds bounds;
+    // When `bounds` is infinite because of floor planes (clip_regions, compiler/lower.hpp):
+    // every surface lies in solid_bounds (possibly empty) or in one of these half-spaces
+    // n.p <= w (unit n). Empty otherwise.
+    Bounds solid_bounds;
+    std::vector<glm::vec4> half_spaces;
     bool is_2d = false;
     bool raw_field = false;
     float time = 0.0f;

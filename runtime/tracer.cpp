@@ -164,7 +164,7 @@ float schlick(float cos_theta, float ior) {
 // d >= ivlo > 0 everywhere in it) jump to where they leave the box, plus ivlo.
 constexpr int kTreeMaxDepth = 16;
 constexpr size_t kTreeLeafTape = 64;      // tapes this short are not split further
-constexpr size_t kTreeMinProgram = 256;   // shorter programs get no tree (lookups would cost more)
+constexpr size_t kTreeMinProgram = 128;   // shorter programs get no tree (lookups would cost more)
 constexpr size_t kTreePilot = 32;          // after splits worth this many programs ...
 constexpr double kTreeUseless = 0.6;      // ... surface cells' tapes this long: no tree
 constexpr size_t kTreeMaxNodes = size_t(1) << 20;
@@ -172,7 +172,7 @@ constexpr int kTreeMaxStall = 3;          // splits in a row that did not shorte
 constexpr float kTreeNear = 0.25f;        // empty cells are split when the surface is this near (x size)
 // Build work budget (instructions interval-evaluated, 8 boxes at a time): a constant, plus
 // per program instruction, plus per sample of the image (the evaluations it will save).
-constexpr size_t kTreeWorkPerInstr = 64, kTreeWorkBase = size_t(16) << 10, kTreeWorkPerSample = 4;
+constexpr size_t kTreeWorkPerInstr = 64, kTreeWorkBase = size_t(16) << 10, kTreeWorkPerSample = 1;
 
 struct TapeTree {
     static constexpr uint32_t kLeafBit = 0x80000000u;
@@ -515,6 +515,8 @@ struct Frame {
     bool raw = false;
     float raw_lipschitz = 1.0f, raw_max_step = 0.05f;
     glm::vec3 lo{0}, hi{0};
+    std::vector<glm::vec4> planes;  // floor planes as half-spaces n.p <= w (with a margin)
+    glm::vec3 solid_lo{0}, solid_hi{0};  // ... and the box of everything else
     std::vector<glm::vec2> offsets;
     bool want_depth = false, want_normal = false, want_steps = false;
     RenderView view = RenderView::Shaded;
@@ -531,9 +533,17 @@ struct Frame {
     float footprint(float path) const { return camera.footprint_base() + camera.footprint_slope() * path; }
     float bias(const glm::vec3& p, float path) const { return 4.0f * thr(path) + 2e-5f * (1.0f + maxabs3(p)); }
 
-    // Clips [t_min, t_max] to the bounding box; an empty interval becomes t_min = +inf.
+    // Clips [t_min, t_max] to where surfaces can be: the bounding box (clip), or, in a scene
+    // with floor planes, the hull of the parts of the ray in the box of everything else
+    // (solid_lo/hi, may be empty) or under a plane (planes). An empty interval becomes
+    // t_min = +inf.
     void clip_ray(const glm::vec3& o, const glm::vec3& d, float& t_min, float& t_max) const {
+        if (!planes.empty()) return clip_hull(o, d, t_min, t_max);
         if (!clip) return;
+        clip_box(lo, hi, o, d, t_min, t_max);
+    }
+    static void clip_box(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& o, const glm::vec3& d, float& t_min,
+                         float& t_max) {
         for (int a = 0; a < 3; ++a) {
             if (std::fabs(d[a]) < 1e-30f) {
                 if (o[a] < lo[a] || o[a] > hi[a]) t_min = INFINITY;
@@ -545,6 +555,25 @@ struct Frame {
             t_min = std::max(t_min, t1);
             t_max = std::min(t_max, t2);
         }
+        if (!(t_min <= t_max)) t_min = INFINITY;
+    }
+    void clip_hull(const glm::vec3& o, const glm::vec3& d, float& t_min, float& t_max) const {
+        float a = INFINITY, b = -INFINITY;
+        if (solid_lo.x <= solid_hi.x && solid_lo.y <= solid_hi.y && solid_lo.z <= solid_hi.z) {
+            float t0 = t_min, t1 = t_max;
+            clip_box(solid_lo, solid_hi, o, d, t0, t1);
+            if (t0 <= t1) a = t0, b = t1;
+        }
+        for (const glm::vec4& q : planes) {
+            // Under the plane where s + v t <= 0.
+            const float s = q.x * o.x + q.y * o.y + q.z * o.z - q.w, v = q.x * d.x + q.y * d.y + q.z * d.z;
+            float t0 = t_min, t1 = t_max;
+            if (v < 0.0f) t0 = std::max(t0, -s / v);
+            else if (v > 0.0f) t1 = std::min(t1, -s / v);
+            else if (!(s <= 0.0f)) continue;
+            if (t0 <= t1) a = std::min(a, t0), b = std::max(b, t1);
+        }
+        t_min = a, t_max = b;
         if (!(t_min <= t_max)) t_min = INFINITY;
     }
 };
@@ -1685,6 +1714,13 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
         f.lo = scene.bounds.lo - margin;
         f.hi = scene.bounds.hi + margin;
         f.clip = f.lo.x <= f.hi.x && f.lo.y <= f.hi.y && f.lo.z <= f.hi.z;
+    } else if (!f.raw && !scene.half_spaces.empty()) {
+        const Bounds& sb = scene.solid_bounds;
+        const bool any = sb.lo.x <= sb.hi.x && sb.lo.y <= sb.hi.y && sb.lo.z <= sb.hi.z;
+        const float margin = 1e-3f * (any ? std::max(max3(sb.hi - sb.lo), 0.0f) : 0.0f) + 1e-3f;
+        f.solid_lo = any ? sb.lo - margin : glm::vec3(1.0f);
+        f.solid_hi = any ? sb.hi + margin : glm::vec3(-1.0f);
+        for (const glm::vec4& q : scene.half_spaces) f.planes.emplace_back(glm::vec3(q), q.w + margin + 1e-3f * std::fabs(q.w));
     }
     if (f.raw) {
         f.raw_lipschitz = estimate_lipschitz(scene, f.lo, f.hi);
@@ -1705,6 +1741,7 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
     if (options.baseline) {
         f.relax = 1.0f;
         f.premarch = false;
+        f.planes.clear();
         if (!f.raw) f.clip = false;
     }
     f.tree.init_full(scene.distance);
