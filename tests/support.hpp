@@ -25,6 +25,23 @@ inline std::unique_ptr<Compiled> compile_text(const std::string& src, const std:
     return c;
 }
 
+// out := op(r0, r1, r2, k) with r0..r2 = x, y, z: one opcode alone, for walking the opcode
+// table through every backend.
+inline Program single_op_program(Op op, float k) {
+    Program p;
+    p.code.push_back(Instr{Op::VarX, 0, 0});
+    p.code.push_back(Instr{Op::VarY, 0, 1});
+    p.code.push_back(Instr{Op::VarZ, 0, 2});
+    Instr in{op};
+    in.out = 3, in.a = 0, in.b = 1, in.c = 2, in.k = k;
+    p.code.push_back(in);
+    p.locs.resize(p.code.size());
+    p.num_regs = 4;
+    p.outputs = {3};
+    p.output_names = {"out"};
+    return p;
+}
+
 // The distance program at one point (batch VM, one lane).
 inline float dist(const CompiledScene& cs, float x, float y, float z) {
     Evaluator ev(cs.distance);

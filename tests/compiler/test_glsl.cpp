@@ -135,21 +135,6 @@ std::string template_expr(Op op) {
     return strip_outer(t);
 }
 
-// A program computing one `op` from the inputs (and k = 0.5).
-Program one_op_program(Op op) {
-    Program p;
-    p.code.push_back(Instr{Op::VarX, 0, 0});
-    p.code.push_back(Instr{Op::VarY, 0, 1});
-    p.code.push_back(Instr{Op::VarZ, 0, 2});
-    Instr in{op, 0, 3, 0, 1, 2};
-    in.k = 0.5f;
-    p.code.push_back(in);
-    p.locs.resize(p.code.size());
-    p.num_regs = 4;
-    p.outputs = {3};
-    p.output_names = {"out"};
-    return p;
-}
 
 }  // namespace
 
@@ -198,7 +183,7 @@ TEST_CASE("glsl: every opcode goes through the emitter as its opcodes.def templa
         spec.signature = fmt::format("float op_{}(vec3 p)", info.mnemonic);
         spec.var_prefix = "v";
         spec.inline_limit = 1000;
-        const std::string fn = glsl::function(one_op_program(op), spec);
+        const std::string fn = glsl::function(test::single_op_program(op, 0.5f), spec);
         const std::string expect = template_expr(op);
         INFO("emitted:\n" << fn << "expected to contain: " << expect);
         CHECK(fn.find(expect) != std::string::npos);

@@ -7,30 +7,11 @@
 
 #include "compiler/program.hpp"
 #include "runtime/vm.hpp"
+#include "support.hpp"
 
 using namespace sdfc;
 
 namespace {
-
-// A program computing one instance of `op` from inputs x, y, z (registers 0..2).
-Program single_op_program(Op op, float k) {
-    Program p;
-    p.code.push_back(Instr{Op::VarX, 0, 0});
-    p.code.push_back(Instr{Op::VarY, 0, 1});
-    p.code.push_back(Instr{Op::VarZ, 0, 2});
-    Instr in{op};
-    in.out = 3;
-    in.a = 0;
-    in.b = 1;
-    in.c = 2;
-    in.k = k;
-    p.code.push_back(in);
-    p.locs.resize(p.code.size());
-    p.num_regs = 4;
-    p.outputs = {3};
-    p.output_names = {"out"};
-    return p;
-}
 
 bool same(float a, float b) {
     if (std::isnan(a) || std::isnan(b)) return std::isnan(a) && std::isnan(b);
@@ -51,7 +32,7 @@ TEST_CASE("every opcode: batch VM lanes equal the scalar semantics") {
         Op op = static_cast<Op>(o);
         const OpInfo& info = op_info(op);
         const float k = 0.75f;
-        Program p = single_op_program(op, k);
+        Program p = test::single_op_program(op, k);
         Evaluator ev(p);
         ev.eval(xs, ys, zs, kBatch, 2.5f);
         for (int i = 0; i < kBatch; ++i) {
@@ -78,7 +59,7 @@ TEST_CASE("every opcode: the disassembler names it with its operands") {
     for (int o = 0; o < kOpCount; ++o) {
         Op op = static_cast<Op>(o);
         const OpInfo& info = op_info(op);
-        std::string text = disassemble(single_op_program(op, 0.75f));
+        std::string text = disassemble(test::single_op_program(op, 0.75f));
         std::string line = "0003  " + std::string(info.mnemonic);
         INFO(text);
         REQUIRE(text.find(line) != std::string::npos);

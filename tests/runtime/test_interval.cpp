@@ -19,21 +19,6 @@ using namespace sdfc;
 
 namespace {
 
-// out := op(r0, r1, r2, k) with r0..r2 = x, y, z.
-Program one_op(Op op, float k) {
-    Program p;
-    p.code.push_back(Instr{Op::VarX, 0, 0});
-    p.code.push_back(Instr{Op::VarY, 0, 1});
-    p.code.push_back(Instr{Op::VarZ, 0, 2});
-    Instr in{op};
-    in.out = 3, in.a = 0, in.b = 1, in.c = 2, in.k = k;
-    p.code.push_back(in);
-    p.locs.resize(p.code.size());
-    p.num_regs = 4;
-    p.outputs = {3};
-    p.output_names = {"out"};
-    return p;
-}
 
 bool unknown(Interval r) { return std::isnan(r.lo) || std::isnan(r.hi); }
 
@@ -78,7 +63,7 @@ TEST_CASE("every opcode: the interval encloses the VM's value at every point of 
             // Unknown is both ends NaN, never one.
             INFO(op_info(op).mnemonic << " k=" << k << " a=[" << A.lo << "," << A.hi << "] b=[" << B.lo << "," << B.hi << "] c=[" << C.lo << "," << C.hi << "] -> [" << r.lo << "," << r.hi << "]");
             REQUIRE(std::isnan(r.lo) == std::isnan(r.hi));
-            Program p = one_op(op, k);
+            Program p = test::single_op_program(op, k);
             Evaluator ev(p);
             float xs[kBatch], ys[kBatch], zs[kBatch];
             auto sample = [&](Interval I, int i) {
