@@ -84,6 +84,7 @@ struct Dumper {
             line(d, "(none)");
             return;
         }
+        check_stack(e->loc);  // trees as tall as the parser allows (see lang/source.hpp)
         switch (e->kind) {
             case ExprKind::Number: line(d, fmt::format("number {}", e->number)); break;
             case ExprKind::Bool: line(d, e->boolean ? "bool true" : "bool false"); break;
@@ -164,6 +165,7 @@ struct Dumper {
     }
 
     void stmt(const Stmt* s, int d) {
+        check_stack(s->loc);
         switch (s->kind) {
             case StmtKind::Let:
             case StmtKind::Var:

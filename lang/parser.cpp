@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <new>
 #include <memory>
 #include <mutex>
@@ -30,6 +31,8 @@
 #include <type_traits>
 #include <utility>
 #include <vector>
+
+#include <pthread.h>
 
 #include <fmt/format.h>
 
@@ -116,6 +119,9 @@ struct State {
     ItemStack items;
     size_t frame = 0;  // the current rule's frame: the stack size when it started
     unsigned depth = 0;
+    // First attempt on the caller's stack: when the stack runs low before max_depth, give
+    // up with StackTooSmall (parse() retries on a thread with a stack sized for max_depth).
+    bool retry_on_low_stack = false;
     const char* block_end = nullptr;  // where the last block's `}` (and the space after it) ended
 
     // Lines are counted here, not by PEGTL (the input tracks no positions): `line` caches
@@ -817,6 +823,9 @@ struct may_push {
     }();
 };
 
+// Thrown (and caught in parse()) when the caller's stack runs out before the depth limit.
+struct StackTooSmall {};
+
 template <typename Rule>
 struct base_control : pegtl::normal<Rule> {
     template <pegtl::apply_mode A, pegtl::rewind_mode M, template <typename...> class Action,
@@ -843,7 +852,10 @@ struct base_control : pegtl::normal<Rule> {
             if (st.depth >= st.max_depth)
                 throw CompileError(st.loc_at(in.current()), fmt::format("nesting deeper than {} levels", st.max_depth));
             // Whatever max_depth was raised to, stop before the C++ stack runs out.
-            if (stack_nearly_exhausted()) check_stack(st.loc_at(in.current()));
+            if (stack_nearly_exhausted()) {
+                if (st.retry_on_low_stack) throw StackTooSmall{};
+                check_stack(st.loc_at(in.current()));
+            }
             ++st.depth;
             guard.depth = &st.depth;
         }
@@ -1134,10 +1146,13 @@ void* Stmt::operator new(std::size_t size) { return ::operator new(size); }
 void Stmt::operator delete(void* p, std::size_t) noexcept { ::operator delete(p); }
 #endif
 
-std::unique_ptr<Module> parse(const SourceFile& file, const ParseOptions& opts) {
+namespace {
+
+std::unique_ptr<Module> parse_on_this_stack(const SourceFile& file, unsigned max_depth, bool retry_on_low_stack) {
     State st;
     st.file = &file;
-    st.max_depth = static_cast<unsigned>(std::max(opts.max_nesting, 1));
+    st.max_depth = max_depth;
+    st.retry_on_low_stack = retry_on_low_stack;
     // Operator chains make trees taller than their nesting; later stages recurse over the
     // tree, so its height is bounded too.
     st.max_height = std::max(4 * st.max_depth, 64u);
@@ -1157,6 +1172,90 @@ std::unique_ptr<Module> parse(const SourceFile& file, const ParseOptions& opts) 
     m->stmts.reserve(st.items.size());
     for (auto& it : st.items) m->stmts.push_back(own_stmt(it));
     return m;
+}
+
+// The stack a parse on its own thread gets: this much per nesting level, far more than any
+// build uses (a level is a few dozen PEGTL frames: about 1 KB in Release, 8-12 KB under
+// AddressSanitizer), plus a base. It is address space, touched only as deep as the input
+// goes. Bounded; beyond it the stack guard reports the input as too deeply nested.
+// Sanitizer builds cap it, so there a raised --max-nesting may end at the stack guard first:
+// - AddressSanitizer: at most 48 MB. An exception thrown with more than 64 MB of stack in
+//   use leaves the stack poisoned (ASan's __asan_handle_no_return gives up), and the
+//   unwinding reports false errors.
+// - ThreadSanitizer: at most 8 MB. It stops the program ("CHECK failed ... kStackSizeBits")
+//   when it records a stack of more than 65,536 frames; 8 MB holds about 40,000 of the
+//   parser's (about 200 bytes each).
+#if defined(__SANITIZE_ADDRESS__)
+#define SDFC_PARSER_ASAN 1
+#elif defined(__SANITIZE_THREAD__)
+#define SDFC_PARSER_TSAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define SDFC_PARSER_ASAN 1
+#elif __has_feature(thread_sanitizer)
+#define SDFC_PARSER_TSAN 1
+#endif
+#endif
+constexpr size_t kStackPerLevel = 64u << 10;
+constexpr size_t kStackBase = 8u << 20;
+#if defined(SDFC_PARSER_ASAN)
+constexpr size_t kMaxStack = 48u << 20;
+#elif defined(SDFC_PARSER_TSAN)
+constexpr size_t kMaxStack = 8u << 20;
+#else
+constexpr size_t kMaxStack = size_t(4) << 30;
+#endif
+
+struct ParseJob {
+    const SourceFile* file;
+    unsigned max_depth;
+    std::unique_ptr<Module> module;
+    std::exception_ptr error;
+};
+
+void* run_parse_job(void* p) {
+    auto* job = static_cast<ParseJob*>(p);
+    try {
+        job->module = parse_on_this_stack(*job->file, job->max_depth, false);
+    } catch (...) {
+        job->error = std::current_exception();
+    }
+    return nullptr;
+}
+
+// Parses on a new thread whose stack fits max_depth levels; false when no such thread can
+// be made (the caller then parses on its own stack, stopped by the stack guard).
+bool parse_on_big_stack(ParseJob& job) {
+    const size_t want = std::min(kStackBase + size_t(job.max_depth) * kStackPerLevel, kMaxStack);
+    pthread_attr_t attr;
+    if (pthread_attr_init(&attr) != 0) return false;
+    pthread_t t;
+    bool started = pthread_attr_setstacksize(&attr, want) == 0 && pthread_create(&t, &attr, run_parse_job, &job) == 0;
+    pthread_attr_destroy(&attr);
+    if (!started) return false;
+    pthread_join(t, nullptr);
+    return true;
+}
+
+}  // namespace
+
+// Parsing recurses once per nesting level (parentheses, blocks, modifiers, operands), a few
+// dozen frames each. The caller's stack (8 MB for the main thread, often less for others)
+// may run out before max_nesting, the sooner in sanitizer builds: then the parse starts
+// again on a thread with a stack sized for max_nesting, so the depth limit, not the build or
+// the thread, decides where deep input stops, always as "nesting deeper than N levels".
+// (That thread's nodes come from its own pool; freed later by the caller, they go to the
+// caller's pool, which reuses them: NodePool allows any thread to free a node.)
+std::unique_ptr<Module> parse(const SourceFile& file, const ParseOptions& opts) {
+    const auto max_depth = static_cast<unsigned>(std::max(opts.max_nesting, 1));
+    try {
+        return parse_on_this_stack(file, max_depth, true);
+    } catch (const StackTooSmall&) {
+    }
+    ParseJob job{&file, max_depth, nullptr, nullptr};
+    if (!parse_on_big_stack(job)) return parse_on_this_stack(file, max_depth, false);
+    if (job.error) std::rethrow_exception(job.error);
+    return std::move(job.module);
 }
 
 }  // namespace sdfc::ast

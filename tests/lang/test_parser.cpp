@@ -6,6 +6,8 @@
 #include <cstring>
 #include <thread>
 
+#include <pthread.h>
+
 #include <fmt/format.h>
 
 #include "grammar/sdf_grammar.hpp"
@@ -729,6 +731,43 @@ TEST_CASE("the nesting limit is a parameter", "[parser]") {
     s = "x = 0";
     for (int i = 0; i < 500; ++i) s += " + 1";
     CHECK_NOTHROW(parse_text(s + ";"));
+}
+
+// Runs f() on a new thread with a stack of `bytes` (the caller's stack must not matter).
+template <typename F>
+void on_small_stack(size_t bytes, F f) {
+    pthread_attr_t attr;
+    REQUIRE(pthread_attr_init(&attr) == 0);
+    REQUIRE(pthread_attr_setstacksize(&attr, bytes) == 0);
+    pthread_t t;
+    auto run = [](void* p) -> void* {
+        (*static_cast<F*>(p))();
+        return nullptr;
+    };
+    REQUIRE(pthread_create(&t, &attr, run, &f) == 0);
+    pthread_attr_destroy(&attr);
+    pthread_join(t, nullptr);
+}
+
+TEST_CASE("the nesting limit, not the caller's stack, decides where deep input stops", "[parser]") {
+    ParseOptions opts;
+    opts.max_nesting = 1024;
+    const std::string ok = "x = " + std::string(1000, '(') + "1" + std::string(1000, ')') + ";";
+    const std::string deep = "x = " + std::string(100000, '[') + "1" + std::string(100000, ']') + ";";
+    // A 256 KB stack is used up at once (the guard keeps 512 KB); the parser moves to a
+    // thread with a stack for 1024 levels.
+    std::string ok_error, deep_error;
+    on_small_stack(256u << 10, [&] {
+        ok_error = error_of(ok, opts);
+        deep_error = error_of(deep, opts);
+    });
+    CHECK(ok_error == "no error");
+    CHECK(deep_error == "1:1028: nesting deeper than 1024 levels");
+    // And on this thread, deeper than its stack allows (the main thread's 8 MB holds about
+    // 1,000 levels in sanitizer builds).
+    opts.max_nesting = 3000;
+    CHECK(error_of("x = " + std::string(2990, '(') + "1" + std::string(2990, ')') + ";", opts) == "no error");
+    CHECK(error_of(deep, opts) == "1:3004: nesting deeper than 3000 levels");
 }
 
 // ------------------------------------------------------- fast paths (sdf_grammar.hpp "Speed")
