@@ -1,10 +1,12 @@
 // Helpers shared by the test suites: compile a script from a string, evaluate distances,
 // capture the first diagnostic.
 #pragma once
+#include <cmath>
 #include <string>
 
 #include "compiler/compile.hpp"
 #include "lang/interpreter.hpp"
+#include "runtime/image.hpp"
 #include "runtime/vm.hpp"
 
 namespace sdfc::test {
@@ -40,6 +42,16 @@ inline Program single_op_program(Op op, float k) {
     p.outputs = {3};
     p.output_names = {"out"};
     return p;
+}
+
+// Every value of every channel and AOV plane is finite (no NaN pixels).
+inline bool all_finite(const Image& img) {
+    for (float v : img.pixels)
+        if (!std::isfinite(v)) return false;
+    for (const auto& a : img.aovs)
+        for (float v : a.data)
+            if (!std::isfinite(v)) return false;
+    return true;
 }
 
 // The distance program at one point (batch VM, one lane).

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "run.hpp"
+#include "support.hpp"
 #include "runtime/image.hpp"
 
 using namespace sdfc;
@@ -20,16 +21,6 @@ using test::run_sdfc;
 namespace fs = std::filesystem;
 
 namespace {
-
-// Every value of every channel and AOV plane is finite.
-bool all_finite(const Image& img) {
-    for (float v : img.pixels)
-        if (!std::isfinite(v)) return false;
-    for (const auto& a : img.aovs)
-        for (float v : a.data)
-            if (!std::isfinite(v)) return false;
-    return true;
-}
 
 std::string temp_files_of(const std::string& dir) {
     std::string names;
@@ -83,7 +74,7 @@ TEST_CASE("fields that compute NaN or infinity render without NaN pixels, AOVs i
             Image img = read_image(out);
             CHECK(img.width == 24);
             CHECK(img.aovs.size() == 3);
-            CHECK(all_finite(img));
+            CHECK(test::all_finite(img));
         }
     }
 }

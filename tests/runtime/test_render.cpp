@@ -1,6 +1,7 @@
 // Renderer tests: small scenes built by hand (IR Graph -> codegen -> Program), checked by
 // pixels. Also the camera and image files (round trips, atomic replace).
 #include <catch2/catch.hpp>
+#include "support.hpp"
 
 #include <unistd.h>
 
@@ -83,15 +84,6 @@ fs::path temp_dir(const std::string& name) {
     fs::remove_all(d);
     fs::create_directories(d);
     return d;
-}
-
-bool all_finite(const Image& img) {
-    for (float v : img.pixels)
-        if (!std::isfinite(v)) return false;
-    for (const auto& a : img.aovs)
-        for (float v : a.data)
-            if (!std::isfinite(v)) return false;
-    return true;
 }
 
 // The default test scene: a red sphere of radius 1 at the origin, seen from +z.
@@ -258,7 +250,7 @@ TEST_CASE("render: NaN in the field or the material never reaches a pixel", "[re
         RenderOptions o;
         o.aovs = {"depth", "normal", "steps"};
         Image img = render(s, o);
-        CHECK(all_finite(img));
+        CHECK(test::all_finite(img));
         // The right half still shows the sphere.
         CHECK(lum(px(img, project(s, {0.5f, 0, 1}))) > lum(s.background));
     }
@@ -267,7 +259,7 @@ TEST_CASE("render: NaN in the field or the material never reaches a pixel", "[re
     NodeId all_nan = b2.g.unary(Op::Sqrt, b2.g.sub(b2.g.neg(b2.g.abs(b2.x)), b2.c(1)));
     CompiledScene s2 = b2.compile(all_nan, b2.material({1, 1, 1}));
     Image img2 = render(s2, {});
-    CHECK(all_finite(img2));
+    CHECK(test::all_finite(img2));
     CHECK(px(img2, 32, 24) == s2.background);
 }
 
@@ -303,7 +295,7 @@ TEST_CASE("render: steps view is a heat map of the step counts", "[render][aov]"
     RenderOptions o;
     o.view = RenderView::Steps;
     Image img = render(s, o);
-    CHECK(all_finite(img));
+    CHECK(test::all_finite(img));
     // Misses near the silhouette take more steps than the head-on centre: hotter colour.
     glm::vec3 centre = px(img, 32, 24);
     glm::vec2 near_edge = project(s, {1.03f, 0, 0});
@@ -325,7 +317,7 @@ TEST_CASE("render: raw fields (no distance bound) are marched by sign", "[render
     s.distance = codegen(b.g, {b.g.min(f, sheet)}, {"d"});
     s.raw_field = true;
     Image raw = render(s, {});
-    CHECK(all_finite(raw));
+    CHECK(test::all_finite(raw));
     glm::vec3 centre = px(raw, 32, 24);
     CHECK(centre.r > 0.3f);
     CHECK(centre.r > 4.0f * centre.g);
@@ -578,7 +570,7 @@ TEST_CASE("render: a glass sphere refracts a striped wall", "[render][glass]") {
     CHECK(glass_sum > 0.3f * wall_sum);     // and light passes through
     // Total internal reflection and exits stay finite; more bounces never add NaN.
     gs.render.max_bounces = 8;
-    CHECK(all_finite(render(gs, {})));
+    CHECK(test::all_finite(render(gs, {})));
 }
 
 TEST_CASE("render: more samples and cone tracing add edge tones", "[render][aa]") {
