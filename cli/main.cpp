@@ -461,7 +461,9 @@ int dispatch(int argc, char** argv) {
 }  // namespace
 }  // namespace sdfc::cli
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
     try {
         return sdfc::cli::dispatch(argc, argv);
     } catch (const sdfc::CompileError& e) {
@@ -475,4 +477,18 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "sdfc: error: %s\n", e.what());
         return 1;
     }
+}
+
+}  // namespace
+
+// The command runs on a thread with a big stack: the interpreter and the compiler recurse
+// once per level of a deep (legal) script, and the main thread's 8 MB can run out before
+// the limits do, especially with raised limits or under sanitizers. 1 GiB of address space,
+// touched only as deep as the script goes; the stack guard (lang/source.hpp) still stops
+// anything deeper with a located error.
+int main(int argc, char** argv) {
+    int rc = 1;
+    const size_t stack = std::min(sdfc::max_thread_stack(), size_t(1) << 30);
+    if (!sdfc::run_on_new_stack(stack, [&] { rc = run(argc, argv); })) rc = run(argc, argv);
+    return rc;
 }

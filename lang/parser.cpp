@@ -195,7 +195,7 @@ struct State {
     }
     void push_stmt(StmtPtr s, uint32_t height) {
         if (height > max_height)
-            throw CompileError(s->loc, fmt::format("statement nested deeper than {} levels", max_height));
+            throw CompileError(s->loc, fmt::format("statement nested deeper than {} levels (raise it with --max-nesting)", max_height));
         Item& it = items.emplace_back();
         it.tag = Tag::Stmt;
         it.loc = s->loc;
@@ -850,7 +850,7 @@ struct base_control : pegtl::normal<Rule> {
         } guard{nullptr};
         if constexpr (nests) {
             if (st.depth >= st.max_depth)
-                throw CompileError(st.loc_at(in.current()), fmt::format("nesting deeper than {} levels", st.max_depth));
+                throw CompileError(st.loc_at(in.current()), fmt::format("nesting deeper than {} levels (raise it with --max-nesting)", st.max_depth));
             // Whatever max_depth was raised to, stop before the C++ stack runs out.
             if (stack_nearly_exhausted()) {
                 if (st.retry_on_low_stack) throw StackTooSmall{};
@@ -1177,34 +1177,10 @@ std::unique_ptr<Module> parse_on_this_stack(const SourceFile& file, unsigned max
 // The stack a parse on its own thread gets: this much per nesting level, far more than any
 // build uses (a level is a few dozen PEGTL frames: about 1 KB in Release, 8-12 KB under
 // AddressSanitizer), plus a base. It is address space, touched only as deep as the input
-// goes. Bounded; beyond it the stack guard reports the input as too deeply nested.
-// Sanitizer builds cap it, so there a raised --max-nesting may end at the stack guard first:
-// - AddressSanitizer: at most 48 MB. An exception thrown with more than 64 MB of stack in
-//   use leaves the stack poisoned (ASan's __asan_handle_no_return gives up), and the
-//   unwinding reports false errors.
-// - ThreadSanitizer: at most 8 MB. It stops the program ("CHECK failed ... kStackSizeBits")
-//   when it records a stack of more than 65,536 frames; 8 MB holds about 40,000 of the
-//   parser's (about 200 bytes each).
-#if defined(__SANITIZE_ADDRESS__)
-#define SDFC_PARSER_ASAN 1
-#elif defined(__SANITIZE_THREAD__)
-#define SDFC_PARSER_TSAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define SDFC_PARSER_ASAN 1
-#elif __has_feature(thread_sanitizer)
-#define SDFC_PARSER_TSAN 1
-#endif
-#endif
+// goes. Bounded by max_thread_stack() (lang/source.cpp, smaller in sanitizer builds);
+// beyond it the stack guard reports the input as too deeply nested.
 constexpr size_t kStackPerLevel = 64u << 10;
 constexpr size_t kStackBase = 8u << 20;
-#if defined(SDFC_PARSER_ASAN)
-constexpr size_t kMaxStack = 48u << 20;
-#elif defined(SDFC_PARSER_TSAN)
-constexpr size_t kMaxStack = 8u << 20;
-#else
-constexpr size_t kMaxStack = size_t(4) << 30;
-#endif
 
 struct ParseJob {
     const SourceFile* file;
@@ -1213,28 +1189,17 @@ struct ParseJob {
     std::exception_ptr error;
 };
 
-void* run_parse_job(void* p) {
-    auto* job = static_cast<ParseJob*>(p);
-    try {
-        job->module = parse_on_this_stack(*job->file, job->max_depth, false);
-    } catch (...) {
-        job->error = std::current_exception();
-    }
-    return nullptr;
-}
-
 // Parses on a new thread whose stack fits max_depth levels; false when no such thread can
 // be made (the caller then parses on its own stack, stopped by the stack guard).
 bool parse_on_big_stack(ParseJob& job) {
-    const size_t want = std::min(kStackBase + size_t(job.max_depth) * kStackPerLevel, kMaxStack);
-    pthread_attr_t attr;
-    if (pthread_attr_init(&attr) != 0) return false;
-    pthread_t t;
-    bool started = pthread_attr_setstacksize(&attr, want) == 0 && pthread_create(&t, &attr, run_parse_job, &job) == 0;
-    pthread_attr_destroy(&attr);
-    if (!started) return false;
-    pthread_join(t, nullptr);
-    return true;
+    const size_t want = std::min(kStackBase + size_t(job.max_depth) * kStackPerLevel, max_thread_stack());
+    return run_on_new_stack(want, [&job] {
+        try {
+            job.module = parse_on_this_stack(*job.file, job.max_depth, false);
+        } catch (...) {
+            job.error = std::current_exception();
+        }
+    });
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #pragma once
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -76,5 +77,12 @@ std::string nearest_name(std::string_view name, const std::vector<std::string>& 
 // whatever the limits (--max-nesting, --max-recursion, --max-shape-depth) are raised to.
 void check_stack(Loc loc);
 bool stack_nearly_exhausted();  // the test alone (when making the Loc costs something)
+
+// The most stack this build gives a thread of its own: 4 GiB of address space (touched
+// only as deep as the input goes), less under sanitizers (see lang/source.cpp).
+size_t max_thread_stack();
+// Runs `fn` on a new thread with a stack of `bytes` and waits for it; false (fn not run)
+// when no such thread can be made. `fn` must not throw.
+bool run_on_new_stack(size_t bytes, const std::function<void()>& fn);
 
 }  // namespace sdfc

@@ -680,7 +680,7 @@ TEST_CASE("deep nesting is an error, not a crash", "[parser]") {
         }
         return std::string("no error");
     };
-    const std::string limit = "nesting deeper than 256 levels";
+    const std::string limit = "nesting deeper than 256 levels (raise it with --max-nesting)";
     CHECK(message(std::string(n, '(') + "1" + std::string(n, ')') + ";") == limit);
     CHECK(message(std::string(n, '{') + std::string(n, '}')) == limit);
     CHECK(message(std::string(n, '{')) == limit);
@@ -717,7 +717,7 @@ TEST_CASE("deep nesting is an error, not a crash", "[parser]") {
 TEST_CASE("the nesting limit is a parameter", "[parser]") {
     ParseOptions opts;
     opts.max_nesting = 10;
-    CHECK(error_of("x = ((((((((((1))))))))));", opts) == "1:14: nesting deeper than 10 levels");
+    CHECK(error_of("x = ((((((((((1))))))))));", opts) == "1:14: nesting deeper than 10 levels (raise it with --max-nesting)");
     CHECK_NOTHROW(parse_text("x = ((((((1))))));", opts));
     // The default allows realistic depth.
     std::string s = "x = " + std::string(200, '(') + "1" + std::string(200, ')') + ";";
@@ -762,12 +762,12 @@ TEST_CASE("the nesting limit, not the caller's stack, decides where deep input s
         deep_error = error_of(deep, opts);
     });
     CHECK(ok_error == "no error");
-    CHECK(deep_error == "1:1028: nesting deeper than 1024 levels");
+    CHECK(deep_error == "1:1028: nesting deeper than 1024 levels (raise it with --max-nesting)");
     // And on this thread, deeper than its stack allows (the main thread's 8 MB holds about
     // 1,000 levels in sanitizer builds).
     opts.max_nesting = 3000;
     CHECK(error_of("x = " + std::string(2990, '(') + "1" + std::string(2990, ')') + ";", opts) == "no error");
-    CHECK(error_of(deep, opts) == "1:3004: nesting deeper than 3000 levels");
+    CHECK(error_of(deep, opts) == "1:3004: nesting deeper than 3000 levels (raise it with --max-nesting)");
 }
 
 // ------------------------------------------------------- fast paths (sdf_grammar.hpp "Speed")
