@@ -202,18 +202,37 @@ int cmd_render(Args& a) {
     if (scenes.size() > 1 && out->find("{name}") == std::string::npos)
         throw UsageError("rendering several scenes needs {name} in the output name");
     float base_time = time_s ? Args::to_float("--time", *time_s) : 0.0f;
+    auto compile_frame = [&](SourceManager& sm, const std::string& path, int f) {
+        float t = animated ? base_time + float(f) / fps : base_time;
+        CompiledScene cs;
+        try {
+            cs = build(sm, path, c, t);
+        } catch (const CompileError& e) {
+            if (!animated || f1 == f0) throw;
+            std::vector<Diagnostic> d = e.diagnostics();
+            for (auto& x : d) x.message += fmt::format(" (at frame {}, time {})", f, t);
+            throw CompileError(std::move(d));
+        }
+        std::vector<std::string> flat;
+        for (auto& [k, v] : ov)
+            if (v) { flat.push_back(k); flat.push_back(*v); }
+        Args overrides(flat);
+        apply_overrides(cs, overrides, c);
+        return cs;
+    };
+    // With several outputs, every frame of every scene compiles before the first image is
+    // written: an error at any frame leaves no output at all (LANGUAGE.md section 9).
+    if (f1 > f0 || scenes.size() > 1)
+        for (const std::string& path : scenes)
+            for (int f = f0; f <= f1; ++f) {
+                SourceManager sm;
+                (void)compile_frame(sm, path, f);
+            }
     for (const std::string& path : scenes) {
         std::string name = std::filesystem::path(path).stem().string();
         for (int f = f0; f <= f1; ++f) {
             SourceManager sm;
-            float t = animated ? base_time + float(f) / fps : base_time;
-            CompiledScene cs = build(sm, path, c, t);
-            Args oa({});
-            std::vector<std::string> flat;
-            for (auto& [k, v] : ov)
-                if (v) { flat.push_back(k); flat.push_back(*v); }
-            Args overrides(flat);
-            apply_overrides(cs, overrides, c);
+            CompiledScene cs = compile_frame(sm, path, f);
             std::string target = expand(*out, f, name);
             // A progress bar with ETA on a terminal, for renders past a second; the summary
             // line below either way (unless --quiet).

@@ -58,7 +58,7 @@ Bounds shape_bounds(const Graph& g, const Shape& s) {
         }
         case ShapeKind::Ellipsoid: return sym(glm::abs(v3(0)));
         case ShapeKind::Octahedron: return sym(glm::vec3(f(0)));
-        case ShapeKind::Pyramid: return Bounds{{-0.5f, std::min(0.0f, v[0]), -0.5f}, {0.5f, std::max(0.0f, v[0]), 0.5f}};
+        case ShapeKind::Pyramid: return sym({0.5f, std::abs(f(0)) * 0.5f, 0.5f});
         case ShapeKind::HexPrism: return sym({f(1) * 1.1547006f, f(0) * 0.5f, f(1) * 1.1547006f});
         case ShapeKind::TriPrism: return sym({f(1) * 2, f(0) * 0.5f, f(1) * 2});
         case ShapeKind::Plane:

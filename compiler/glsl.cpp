@@ -294,17 +294,18 @@ std::string emit_glsl(const Scene& scene, GlslTarget target) {
             s += header(p,
                         "// A desktop OpenGL 3.3 fragment shader. Draw a full-screen triangle (any vertex shader\n"
                         "// that covers the viewport) and set these uniforms:\n"
-                        "//   uResolution  viewport size in pixels\n"
-                        "//   uTime        scene time in seconds (the script's `time`)\n"
-                        "//   uMouse       Shadertoy's iMouse convention: xy = pointer position in pixels (origin at\n"
+                        "//   iResolution  viewport size in pixels\n"
+                        "//   iTime        scene time in seconds (the script's `time`)\n"
+                        "//   iMouse       Shadertoy's convention: xy = pointer position in pixels (origin at\n"
                         "//                the bottom left), zw = where the button went down, z > 0 while pressed;\n"
                         "//                while pressed, dragging orbits the camera; all zero: the script's camera.\n"
                         "// fragColor is display-ready (sRGB-encoded) colour; write it to an 8-bit framebuffer\n"
                         "// without GL_FRAMEBUFFER_SRGB.\n\n");
-            s += "uniform vec2 uResolution;\nuniform float uTime;\nuniform vec4 uMouse;\nout vec4 fragColor;\n\n";
+            // Shadertoy's names (LANGUAGE.md: `time` becomes iTime in GLSL).
+            s += "uniform vec2 iResolution;\nuniform float iTime;\nuniform vec4 iMouse;\nout vec4 fragColor;\n\n";
             s += p.code;
             s += "\nvoid main() {\n"
-                 "    fragColor = sdf_render(gl_FragCoord.xy, uResolution, uTime, sdf_mouse_orbit(uMouse, uResolution), vec2(0.0));\n"
+                 "    fragColor = sdf_render(gl_FragCoord.xy, iResolution, iTime, sdf_mouse_orbit(iMouse, iResolution), vec2(0.0));\n"
                  "}\n";
             return s;
         }

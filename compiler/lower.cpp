@@ -346,8 +346,11 @@ Lowered lower_primitive(L& l, const Shape& s, const Vec3N& p) {
         case ShapeKind::CappedTorus: {
             // Quilez's sdCappedTorus with the ring in the xz-plane (like torus) and the arc of
             // `angle` degrees symmetric about +z: his (x, y, z) are our (|x|, z, y).
-            NodeId an = l.mul(P(s, 0), l.c(0.5f * kDeg));
-            NodeId sx = g.unary(Op::Sin, an), sy = g.unary(Op::Cos, an);
+            // The angle is clamped to [0, 360] (a time-dependent one can leave it), and sin of
+            // the half angle to >= 0: sin(180 deg) in floats is -8.7e-8, which made the branch
+            // test flip on the plane x = 0 of a full (360 degree) ring.
+            NodeId an = l.mul(l.clamp(P(s, 0), zero, l.c(360.0f)), l.c(0.5f * kDeg));
+            NodeId sx = l.mx(g.unary(Op::Sin, an), zero), sy = g.unary(Op::Cos, an);
             NodeId qx = l.abs(x), qy = z;
             NodeId ra = P(s, 1), rb = P(s, 2);
             NodeId k = l.sel(l.lt(l.mul(sx, qy), l.mul(sy, qx)), l.add(l.mul(qx, sx), l.mul(qy, sy)), l.len2(qx, qy));
@@ -431,8 +434,11 @@ Lowered lower_primitive(L& l, const Shape& s, const Vec3N& p) {
             break;
         }
         case ShapeKind::Pyramid: {
-            // Quilez's exact sdPyramid: square base 1x1 on y = 0 centred on the y axis, apex at y = h.
+            // Quilez's exact sdPyramid (square base 1x1 centred on the y axis, apex h above it),
+            // moved down by h/2 so that it is centred at the origin like every shape: y from
+            // -h/2 to h/2.
             NodeId h = P(s, 0);
+            y = l.add(y, l.mul(h, half));
             NodeId m2 = l.add(l.sq(h), l.c(0.25f));
             NodeId ax = l.abs(x), az = l.abs(z);
             NodeId swap = l.lt(ax, az);

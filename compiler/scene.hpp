@@ -61,6 +61,7 @@ struct Shape {
     float bound = 1.0f;    // Field: the user's Lipschitz bound
     int depth = 1;         // height of this subtree (bounded so lowering cannot overflow the stack)
     size_t tree_size = 1;  // shapes lowering visits here: this one and its subtree, a shared child at each use
+    bool iterations = false;  // Union: a `for` statement's iterations (see csg in lang/builtins.cpp)
 };
 
 struct CameraSettings {

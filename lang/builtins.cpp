@@ -233,6 +233,13 @@ struct Binder {
         for (NodeId n : v) check_size(n, i, positive);
         return v;
     }
+    // A constant from lo to hi (a value known only per time is clamped where it is used).
+    void range(NodeId n, size_t i, float lo, float hi) {
+        finite(n, i);
+        if (in.g->is_const(n) && !(in.g->const_value(n) >= lo && in.g->const_value(n) <= hi))
+            in.fail(loc(i), fmt::format("argument '{}' of {} must be from {} to {}, not {}", info.params[i].name, info.name, lo,
+                                        hi, in.g->const_value(n)));
+    }
     void finite(NodeId n, size_t i) {
         if (in.g->is_const(n) && !std::isfinite(in.g->const_value(n)))
             in.fail(loc(i), fmt::format("argument '{}' of {} must be a finite number", info.params[i].name, info.name));
@@ -294,7 +301,7 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
             case B::RoundBox: s.kind = ShapeKind::RoundBox; push3(p, b.size3(0)); p.push_back(b.size(1)); break;
             case B::BoxFrame: s.kind = ShapeKind::BoxFrame; push3(p, b.size3(0)); p.push_back(b.size(1)); break;
             case B::Torus: s.kind = ShapeKind::Torus; p = {b.size(0), b.size(1)}; break;
-            case B::CappedTorus: s.kind = ShapeKind::CappedTorus; p = {b.num(0), b.size(1), b.size(2)}; b.finite(p[0], 0); break;
+            case B::CappedTorus: s.kind = ShapeKind::CappedTorus; p = {b.num(0), b.size(1), b.size(2)}; b.range(p[0], 0, 0, 360); break;
             case B::Link: s.kind = ShapeKind::Link; p = {b.size(0), b.size(1), b.size(2)}; break;
             case B::Cylinder: s.kind = ShapeKind::Cylinder; p = {b.size(0), b.size(1)}; break;
             case B::RoundCylinder: s.kind = ShapeKind::RoundCylinder; p = {b.size(0), b.size(1), b.size(2)}; break;
@@ -501,10 +508,22 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
     Shape s{ShapeKind::Union, m.loc};
     auto csg = [&](ShapeKind k) {
         // A CSG operation takes the statements of its block as operands; a single shape
-        // that is itself a union of a block's statements is opened up.
+        // that is itself a union of a block's statements is opened up. A `for` statement is
+        // one operand, the union of its iterations; the union-like operations take its
+        // iterations as operands instead (the same union, and smooth ones blend them).
         s.kind = k;
-        if (target->kind == ShapeKind::Union && !target->children.empty()) s.children = target->children;
+        if (target->kind == ShapeKind::Union && !target->iterations && !target->children.empty()) s.children = target->children;
         else s.children = {target};
+        const bool union_like = k == ShapeKind::Union || k == ShapeKind::SmoothUnion || k == ShapeKind::ChamferUnion ||
+                                k == ShapeKind::StairsUnion;
+        if (union_like && std::any_of(s.children.begin(), s.children.end(), [](const ShapePtr& c) { return c->iterations; })) {
+            std::vector<ShapePtr> flat;
+            for (const ShapePtr& c : s.children) {
+                if (c->iterations) flat.insert(flat.end(), c->children.begin(), c->children.end());
+                else flat.push_back(c);
+            }
+            s.children = std::move(flat);
+        }
     };
     switch (m.id) {
         case B::Union: csg(ShapeKind::Union); break;
@@ -574,7 +593,11 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
         case B::PolarRepeat: s.kind = ShapeKind::PolarRepeat; s.params = {n0(0, 1)}; s.children = {target}; break;
         case B::Symmetry: {
             s.kind = ShapeKind::Symmetry;
-            for (size_t i = 0; i < 3; ++i) s.params.push_back(arg(i) ? truth(*arg(i), a.locs[i]) : gr.constant(0));
+            // LANGUAGE.md writes symmetry(x=true, y=, z=): x is folded unless y or z is named
+            // (a bare `symmetry()` mirrors x; `symmetry(y = true)` only y).
+            const bool x_default = !arg(1) && !arg(2);
+            for (size_t i = 0; i < 3; ++i)
+                s.params.push_back(arg(i) ? truth(*arg(i), a.locs[i]) : gr.constant(i == 0 && x_default ? 1.0f : 0.0f));
             s.children = {target};
             break;
         }

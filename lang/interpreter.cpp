@@ -221,6 +221,10 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             auto it = env->vars.find(s.name);
             if (it != env->vars.end())
                 fail(s.name_loc, fmt::format("'{}' is already defined in this scope (at line {})", s.name, it->second.loc.line));
+            for (size_t i = 0; i < s.params.size(); ++i)
+                for (size_t j = 0; j < i; ++j)
+                    if (s.params[i].name == s.params[j].name)
+                        fail(s.params[i].loc, fmt::format("parameter '{}' is named twice in '{}'", s.params[i].name, s.name));
             auto fn = std::make_shared<Callable>();
             fn->name = s.name;
             fn->def = &s;
@@ -328,9 +332,21 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             }
             return;
         }
-        case ast::StmtKind::For:
-            run_for(s.bindings, env, s.loc, [&](Env* body) { exec(*s.body, body, out); });
+        case ast::StmtKind::For: {
+            // The statement adds one shape, the union of its iterations, so that it is one
+            // operand of a difference or an intersection (as in OpenSCAD).
+            std::vector<ShapePtr> iters;
+            run_for(s.bindings, env, s.loc, [&](Env* body) { exec(*s.body, body, iters); });
+            if (iters.size() <= 1) {
+                out.insert(out.end(), iters.begin(), iters.end());
+                return;
+            }
+            Shape u{ShapeKind::Union, s.loc};
+            u.children = std::move(iters);
+            u.iterations = true;
+            out.push_back(make_shape(std::move(u)));
             return;
+        }
     }
 }
 

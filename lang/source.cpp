@@ -28,12 +28,31 @@ std::string_view SourceFile::line(uint32_t n) const {
 
 std::string format_diagnostic(const Diagnostic& d) {
     if (!d.loc.known()) return fmt::format("sdfc: error: {}\n", d.message);
-    std::string out = fmt::format("{}:{}:{}: error: {}\n", d.loc.file->path, d.loc.line, d.loc.col, d.message);
-    std::string_view src = d.loc.file->line(d.loc.line);
+    const SourceFile& file = *d.loc.file;
+    uint32_t line = d.loc.line;
+    std::string_view src = file.line(line);
+    size_t col = std::min<size_t>(d.loc.col - 1, src.size());  // in bytes
+    auto blank = [](std::string_view t) { return t.find_first_not_of(" \t\r\f\v") == std::string_view::npos; };
+    // An error at the end of the file (a missing `)` or `}`) is shown after the last token,
+    // not on the empty line after the last newline.
+    if (line == file.line_starts.size() && line > 1 && blank(src)) {
+        uint32_t l = line - 1;
+        while (l > 1 && blank(file.line(l))) --l;
+        std::string_view t = file.line(l);
+        if (!blank(t)) {
+            line = l;
+            src = t;
+            col = t.find_last_not_of(" \t\r\f\v") + 1;
+        }
+    }
+    auto continuation = [&](size_t i) { return (static_cast<unsigned char>(src[i]) & 0xC0) == 0x80; };
+    // Columns count characters (UTF-8 code points), not bytes.
+    size_t chars = 0;
+    for (size_t i = 0; i < col; ++i) chars += continuation(i) ? 0 : 1;
+    std::string out = fmt::format("{}:{}:{}: error: {}\n", file.path, line, chars + 1, d.message);
     // A very long line (minified or generated text) is shown as a window around the column.
     constexpr size_t kWindow = 160;
-    size_t col = std::min<size_t>(d.loc.col - 1, src.size()), b = 0, e = src.size();
-    auto continuation = [&](size_t i) { return (static_cast<unsigned char>(src[i]) & 0xC0) == 0x80; };
+    size_t b = 0, e = src.size();
     if (src.size() > 2 * kWindow) {
         b = col > kWindow / 2 ? col - kWindow / 2 : 0;
         while (b > 0 && continuation(b)) --b;
@@ -47,7 +66,8 @@ std::string format_diagnostic(const Diagnostic& d) {
     out += '\n';
     // Keep tabs so the caret lines up in a terminal.
     out.append(lead.size(), ' ');
-    for (size_t i = b; i < col; ++i) out += src[i] == '\t' ? '\t' : ' ';
+    for (size_t i = b; i < col; ++i)
+        if (!continuation(i)) out += src[i] == '\t' ? '\t' : ' ';
     out += "^\n";
     return out;
 }
@@ -128,19 +148,36 @@ void check_source_text(const SourceFile& f) {
 std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates) {
     std::string best;
     if (name.empty() || name.size() > 64) return best;  // no typo of a known name; keeps this cheap
-    // Close enough to be a typo: at most a third of the name wrong, and never all of it.
-    size_t best_d = std::min(std::max<size_t>(1, name.size() / 3), name.size() - 1) + 1;
+    // Edit distance in half steps: a letter of the wrong case costs 1, any other edit 2
+    // (substitution, insertion, deletion, or two neighbours swapped: `lenght`). Close enough
+    // to be a typo: at most a third of the name wrong, and never all of it; ties go to the
+    // first candidate.
+    const size_t n = name.size();
+    size_t best_d = 2 * (std::min(std::max<size_t>(1, n / 3), n - 1) + 1);
+    auto lower = [](char ch) { return (ch >= 'A' && ch <= 'Z') ? char(ch - 'A' + 'a') : ch; };
+    std::vector<size_t> prev2, prev, cur;
     for (const auto& c : candidates) {
-        if ((c.size() > name.size() ? c.size() - name.size() : name.size() - c.size()) >= best_d) continue;
-        std::vector<size_t> prev(c.size() + 1), cur(c.size() + 1);
-        for (size_t j = 0; j <= c.size(); ++j) prev[j] = j;
-        for (size_t i = 1; i <= name.size(); ++i) {
-            cur[0] = i;
-            for (size_t j = 1; j <= c.size(); ++j)
-                cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (name[i - 1] == c[j - 1] ? 0 : 1)});
+        const size_t m = c.size();
+        if (2 * (m > n ? m - n : n - m) >= best_d) continue;
+        prev2.assign(m + 1, 0);
+        prev.resize(m + 1);
+        cur.resize(m + 1);
+        for (size_t j = 0; j <= m; ++j) prev[j] = 2 * j;
+        for (size_t i = 1; i <= n; ++i) {
+            cur[0] = 2 * i;
+            for (size_t j = 1; j <= m; ++j) {
+                const char a = name[i - 1], b = c[j - 1];
+                const size_t sub = a == b ? 0 : lower(a) == lower(b) ? 1 : 2;
+                cur[j] = std::min({prev[j] + 2, cur[j - 1] + 2, prev[j - 1] + sub});
+                if (i > 1 && j > 1 && a == c[j - 2] && name[i - 2] == b) cur[j] = std::min(cur[j], prev2[j - 2] + 2);
+            }
+            std::swap(prev2, prev);
             std::swap(prev, cur);
         }
-        if (prev[c.size()] < best_d) { best_d = prev[c.size()]; best = c; }
+        if (prev[m] < best_d) {
+            best_d = prev[m];
+            best = c;
+        }
     }
     return best;
 }

@@ -92,6 +92,18 @@ TEST_CASE("render --frames writes one file per frame, and they differ where the 
     CHECK(bad.err == "sdfc: error: rendering several frames needs {frame:04d} in the output name\n");
 }
 
+TEST_CASE("an animation whose script fails at a later frame writes no frame and names it") {
+    std::string s = test::write_temp("anim_fail.sdf", "render(width = 16, height = 12);\nsphere(1 - time);\n");
+    fs::path dir = fs::path(test::temp_dir()) / "anim_fail";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    auto r = run_sdfc("render '" + s + "' -o '" + (dir / "f{frame:04d}.png").string() + "' --frames 0:3 --fps 1 --quiet");
+    CHECK(r.status == 1);
+    CHECK(r.err.substr(0, r.err.find('\n')) ==
+          s + ":2:10: error: argument 'r' of sphere must be zero or positive, not -1 (at frame 2, time 2)");
+    CHECK(fs::is_empty(dir));
+}
+
 TEST_CASE("compile --emit lists the AST, the IR and the bytecode") {
     std::string s = test::write_temp("emit.sdf", "translate([1, 0, 0]) sphere(0.5);\n");
     auto ast = run_sdfc("compile '" + s + "' --emit ast");

@@ -235,7 +235,8 @@ TEST_CASE("glsl: every example compiles for every target", "[glsl][examples]") {
 
         const std::string g330 = emit_glsl(s, GlslTarget::Glsl330);
         CHECK(g330.rfind("#version 330 core\n", 0) == 0);
-        CHECK(g330.find("uniform vec2 uResolution;") != std::string::npos);
+        CHECK(g330.find("uniform vec2 iResolution;") != std::string::npos);
+        CHECK(g330.find("uniform float iTime;") != std::string::npos);
         CHECK(g330.find("void main()") != std::string::npos);
 
         const std::string page = emit_glsl(s, GlslTarget::Html);

@@ -50,6 +50,29 @@ TEST_CASE("union, intersection, difference, xor") {
     CHECK(d3(1.5, 1.5, 0) < 0);
 }
 
+TEST_CASE("a for statement in a CSG block is one operand, the union of its iterations") {
+    // LANGUAGE.md section 4: "union of the iterations"; as in OpenSCAD.
+    Field d("difference {\n for (x = [-1, 1]) translate([x, 0, 0]) sphere(0.5);\n sphere(0.2);\n}");
+    CHECK(close(d(1, 0, 0), -0.5));
+    CHECK(close(d(-1, 0, 0), -0.5));
+    CHECK(close(d(0, 0, 0), 0.5));
+    Field i("intersection { for (x = [-1, 1]) translate([x * 0.5, 0, 0]) sphere(1); box(10); }");
+    CHECK(close(i(1.4f, 0, 0), -0.1f));
+    // Cut by a loop: the rest of a difference may be a loop too.
+    Field d2("difference { box(4); for (z = [-1, 1]) translate([0, 0, z]) sphere(0.5); }");
+    CHECK(close(d2(0, 0, 1), 0.5));
+    CHECK(d2(0, 0, 0) < 0);
+    // A lone loop is the first operand and nothing is subtracted.
+    Field d3("difference { for (x = [-1, 1]) translate([x, 0, 0]) sphere(0.5); }");
+    CHECK(close(d3(1, 0, 0), -0.5));
+    CHECK(close(d3(-1, 0, 0), -0.5));
+    // Union-like blocks take the iterations as operands: a smooth union blends them.
+    Field su("smooth_union(1) { for (x = [-1, 1]) translate([x, 0, 0]) sphere(0.8); sphere(0.1); }");
+    Field hu("union { for (x = [-1, 1]) translate([x, 0, 0]) sphere(0.8); sphere(0.1); }");
+    CHECK(close(hu(0, 1, 0), std::sqrt(2.0f) - 0.8f));
+    CHECK(su(0, 1, 0) < hu(0, 1, 0) - 0.1f);
+}
+
 TEST_CASE("smooth operations equal the hard ones beyond k and blend within") {
     Field su("smooth_union(0.5) { sphere(1); translate([3, 0, 0]) sphere(1); }");
     Field si("smooth_intersection(0.5) { sphere(1); translate([1, 0, 0]) sphere(1); }");
@@ -155,6 +178,12 @@ TEST_CASE("symmetry mirrors the positive side onto the negative") {
     Field s2("symmetry(y = true, z = true) translate([0, 1, 1]) sphere(0.5);");
     CHECK(close(s2(0, -1, -1), -0.5));
     CHECK(close(s2(0, 1, -1), -0.5));
+    // LANGUAGE.md: symmetry(x=true, y=, z=). x folds unless y or z is named.
+    Field s3("symmetry() translate([2, 1, 0]) sphere(0.5);");
+    CHECK(close(s3(-2, 1, 0), -0.5));
+    Field s4("symmetry(y = true) translate([2, 1, 0]) sphere(0.5);");
+    CHECK(close(s4(2, -1, 0), -0.5));
+    CHECK(close(s4(-2, 1, 0), 3.5));
 }
 
 TEST_CASE("elongate inserts a straight section of length v") {

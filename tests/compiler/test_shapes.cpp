@@ -91,8 +91,12 @@ TEST_CASE("capped_torus: an arc of the ring in the xz-plane, symmetric about +z"
     CHECK(close(dist_of("capped_torus(180, 1, 0.1);", 0, 0, 1), -0.1));
     // At (0,0,-1) the nearest point of the half ring is an end (±1, 0, 0): distance sqrt(2) - 0.1.
     CHECK(close(dist_of("capped_torus(180, 1, 0.1);", 0, 0, -1), std::sqrt(2.0) - 0.1));
-    // A full circle (360) is the torus.
+    // A full circle (360) is the torus, also on the plane x = 0 (where sin(180 degrees) in
+    // floats once flipped the branch).
     check_random("capped_torus(360, 1, 0.2);", [](dv3 p) { return len2(len2(p.x, p.z) - 1, p.y) - 0.2; });
+    CHECK(close(dist_of("capped_torus(360, 2, 0.5);", 0, 0, 2), -0.5));
+    CHECK(close(dist_of("capped_torus(360, 2, 0.5);", 0, 1, 2), 0.5));
+    CHECK(close(dist_of("capped_torus(360, 2, 0.5);", 0, 0, -2), -0.5));
 }
 
 TEST_CASE("link: a chain link with straight sides along y") {
@@ -173,13 +177,15 @@ TEST_CASE("octahedron: exact") {
     CHECK(close(dist_of("octahedron(1);", 0, 0, 0), -1 / std::sqrt(3.0)));
 }
 
-TEST_CASE("pyramid: base 1x1 on y = 0, apex at h") {
-    CHECK(close(dist_of("pyramid(1);", 0, 2, 0), 1));     // above the apex
-    CHECK(close(dist_of("pyramid(1);", 0, -1, 0), 1));    // below the base
-    CHECK(close(dist_of("pyramid(1);", 1, -1, 0), std::sqrt(1.25)));  // below a base edge
-    CHECK(close(dist_of("pyramid(1);", 1.5, 0, 0), 1.0));   // beside the base edge
-    CHECK(close(dist_of("pyramid(1);", 0, 0.05, 0), -0.05)); // inside, just above the base face
-    CHECK(dist_of("pyramid(1);", 0, 0.2, 0) < 0);
+TEST_CASE("pyramid: base 1x1, apex h above it, centred on the origin") {
+    CHECK(close(dist_of("pyramid(1);", 0, 1.5, 0), 1));     // above the apex (y = 0.5)
+    CHECK(close(dist_of("pyramid(1);", 0, -1.5, 0), 1));    // below the base (y = -0.5)
+    CHECK(close(dist_of("pyramid(1);", 1, -1.5, 0), std::sqrt(1.25)));  // below a base edge
+    CHECK(close(dist_of("pyramid(1);", 1.5, -0.5, 0), 1.0));   // beside the base edge
+    CHECK(close(dist_of("pyramid(1);", 0, -0.45, 0), -0.05)); // inside, just above the base face
+    CHECK(dist_of("pyramid(1);", 0, -0.3, 0) < 0);
+    CHECK(close(dist_of("pyramid(4);", 0, 2, 0), 0));        // the apex
+    CHECK(close(dist_of("pyramid(4);", 0, -2, 0), 0));       // the centre of the base
 }
 
 TEST_CASE("hex_prism: along y, r is the apothem") {

@@ -19,6 +19,29 @@ TEST_CASE("unknown names suggest the nearest known one") {
     CHECK(first_error_line("let radius = 1;\nsphere(radiu);") ==
           "test.sdf:2:8: error: unknown name 'radiu' (did you mean `radius`?)");
     CHECK(first_error_line("zzzzqqq(1);") == "test.sdf:1:1: error: unknown name 'zzzzqqq'");
+    // Two letters swapped count as one edit; a letter of the wrong case as half of one.
+    CHECK(first_error_line("field (p) -> lenght(p) - 1;") ==
+          "test.sdf:1:14: error: unknown name 'lenght' (did you mean `length`?)");
+    CHECK(first_error_line("sphere(clmap(1, 0, 2));") == "test.sdf:1:8: error: unknown name 'clmap' (did you mean `clamp`?)");
+    CHECK(first_error_line("sphere(PI);") == "test.sdf:1:8: error: unknown name 'PI' (did you mean `pi`?)");
+    CHECK(first_error_line("render(widht = 10);\nsphere(1);") ==
+          "test.sdf:1:8: error: render has no parameter 'widht' (did you mean `width`?)");
+}
+
+TEST_CASE("columns count characters; an error at the end of the file points after the last token") {
+    CHECK(error_of("let s = \"\u00fc\u00fc\u00fc\"; sphere(q);") ==
+          "test.sdf:1:23: error: unknown name 'q'\n"
+          "let s = \"\u00fc\u00fc\u00fc\"; sphere(q);\n"
+          "                      ^\n");
+    CHECK(error_of("sphere(1);\nbox(\n") ==
+          "test.sdf:2:5: error: expected ')'\n"
+          "box(\n"
+          "    ^\n");
+    CHECK(first_error_line("union {\n  sphere(1);\n\n\n") == "test.sdf:2:12: error: expected '}'");
+}
+
+TEST_CASE("a def names each parameter once") {
+    CHECK(first_error_line("def f(a, a) = sphere(a);\nf(1, 2);") == "test.sdf:1:10: error: parameter 'a' is named twice in 'f'");
 }
 
 TEST_CASE("wrong argument count, unknown names and types name the parameter") {

@@ -15,12 +15,14 @@ using namespace sdfc;
 namespace {
 
 // k x k spheres on a 16 x 16 square, radius 0.35 of the cell (bench/run's grid);
-// `far_floor`: with a plane far below, an unbounded child, so the union stays a chain in
-// script order (and the plane is too far to bound anything near the spheres).
+// `far_floor`: in one union block with a plane far below, an unbounded child, so the union
+// stays a chain in script order (and the plane is too far to bound anything near the
+// spheres). (A plane beside the loop at the top level would not do: the loop's iterations
+// are then a union of their own, which gets the tree.)
 std::string grid(int k, bool far_floor) {
-    return std::string(far_floor ? "plane([0, 1, 0], -100);\n" : "") + "let c = 16 / " + std::to_string(k) +
+    return std::string(far_floor ? "union {\nplane([0, 1, 0], -100);\n" : "") + "let c = 16 / " + std::to_string(k) +
            ";\nfor (i = [0 : " + std::to_string(k - 1) + "], j = [0 : " + std::to_string(k - 1) +
-           "]) translate([(i + 0.5) * c - 8, 0.35 * c, (j + 0.5) * c - 8]) sphere(0.35 * c);\n";
+           "]) translate([(i + 0.5) * c - 8, 0.35 * c, (j + 0.5) * c - 8]) sphere(0.35 * c);\n" + (far_floor ? "}\n" : "");
 }
 
 // Length of the distance program simplified for the cube of side s around (x, y, z).
