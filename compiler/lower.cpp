@@ -153,6 +153,50 @@ std::array<NodeId, 9> rotation_axis_angle(Graph& g, NodeId angle_deg, const Vec3
             g.sub(m(x, z), g.mul(y, s)), g.add(m(y, z), g.mul(x, s)), g.add(m(z, z), c)};
 }
 
+namespace {
+
+// How many neighbouring cells each side a repeat looks into for a child that reaches out of
+// its own cell (a larger child is cut beyond that).
+constexpr int kRepeatReach = 2;
+
+// The copies of polar_repeat(n) whose child (bounds `b`, copy 0 as given) reaches into
+// sector 0, the one centred on +x (angles atan2(z, x) in [-pi/n, pi/n]): offsets j such
+// that the child turned by j sectors overlaps it. 0 first; at most 2 * kRepeatReach + 1.
+std::vector<int> polar_neighbours(const Bounds& b, float n) {
+    std::vector<int> js{0};
+    if (!(n >= 1.0f) || n != std::floor(n) || !(b.lo.x > -1e29f && b.hi.x < 1e29f && b.lo.z > -1e29f && b.hi.z < 1e29f))
+        return js;
+    const float ang = 2.0f * kPi / n;
+    const int count = int(std::min(n, 1e6f));
+    float a0, a1;  // the child's angular extent
+    if (b.lo.x <= 0 && b.hi.x >= 0 && b.lo.z <= 0 && b.hi.z >= 0) {
+        a0 = -kPi, a1 = kPi;  // around the axis: every direction
+    } else {
+        const float ac = std::atan2(0.5f * (b.lo.z + b.hi.z), 0.5f * (b.lo.x + b.hi.x));
+        a0 = a1 = 0.0f;
+        for (float x : {b.lo.x, b.hi.x})
+            for (float z : {b.lo.z, b.hi.z}) {
+                float d = std::atan2(z, x) - ac;
+                d = d > kPi ? d - 2 * kPi : (d < -kPi ? d + 2 * kPi : d);
+                a0 = std::min(a0, d), a1 = std::max(a1, d);
+            }
+        a0 += ac, a1 += ac;
+    }
+    for (int dj = 1; dj <= count / 2 && int(js.size()) < 2 * kRepeatReach + 1; ++dj)
+        for (int j : {dj, -dj}) {
+            if (j == -dj && 2 * dj == count) continue;  // the same copy as +dj
+            bool hit = false;
+            for (int k = -2; k <= 2 && !hit; ++k) {
+                const float lo = a0 + float(j) * ang + float(k) * 2 * kPi, hi = a1 + float(j) * ang + float(k) * 2 * kPi;
+                hit = lo < 0.5f * ang && hi > -0.5f * ang;
+            }
+            if (hit && int(js.size()) < 2 * kRepeatReach + 1) js.push_back(j);
+        }
+    return js;
+}
+
+}  // namespace
+
 NodeId lower_distance(Graph& g, const Shape& shape, const Vec3N& p) {
     Lowered r = lower_shape(g, shape, p, nullptr);
     return unit(g, r);
@@ -196,28 +240,75 @@ Lowered lower_shape(Graph& g, const Shape& s, const Vec3N& p, const MaterialN* i
         }
         case ShapeKind::Repeat:
         case ShapeKind::RepeatFinite: {
+            // Domain repetition: the point moves into the cell of the nearest copy. A child
+            // that reaches out of its cell would be cut at the cell's faces, so the copies of
+            // the neighbouring cells that reach into this one are evaluated too (from the
+            // child's bounds; none for a child inside its cell, the usual case).
             Vec3N per = P3(s, 0);
-            Vec3N q = p;
+            const Bounds cb = shape_bounds(g, *s.children.at(0));
+            std::array<NodeId, 3> idx{kNoNode, kNoNode, kNoNode};
+            std::array<int, 3> jlo{0, 0, 0}, jhi{0, 0, 0};
             for (int i = 0; i < 3; ++i) {
                 if (g.is_const(per[i]) && g.const_value(per[i]) == 0.0f) continue;  // axis left alone
-                NodeId idx = g.unary(Op::Floor, l.add(l.div(p[i], per[i]), l.c(0.5f)));
-                if (s.kind == ShapeKind::RepeatFinite) {
-                    NodeId cnt = P(s, 3 + i);
-                    idx = l.clamp(idx, l.neg(cnt), cnt);
-                }
-                q[i] = l.sub(p[i], l.mul(per[i], idx));
+                idx[i] = g.unary(Op::Floor, l.add(l.div(p[i], per[i]), l.c(0.5f)));
+                if (s.kind == ShapeKind::RepeatFinite) idx[i] = l.clamp(idx[i], l.neg(P(s, 3 + i)), P(s, 3 + i));
+                if (!g.is_const(per[i]) || !(cb.lo[i] > -1e29f && cb.hi[i] < 1e29f)) continue;
+                const float pe = g.const_value(per[i]), half = 0.5f * pe;  // > 0 (checked by repeat)
+                // Copy j of the neighbours spans [lo + j pe, hi + j pe]: those overlapping
+                // this cell, [-half, half]. At most kRepeatReach each side.
+                jlo[i] = std::max(-kRepeatReach, int(std::floor((-half - cb.hi[i]) / pe)) + 1);
+                jhi[i] = std::min(kRepeatReach, int(std::ceil((half - cb.lo[i]) / pe)) - 1);
+                jlo[i] = std::min(jlo[i], 0);
+                jhi[i] = std::max(jhi[i], 0);
             }
-            out = child(q);
+            bool have = false;
+            for (int jx = jlo[0]; jx <= jhi[0]; ++jx)
+                for (int jy = jlo[1]; jy <= jhi[1]; ++jy)
+                    for (int jz = jlo[2]; jz <= jhi[2]; ++jz) {
+                        const int j[3] = {jx, jy, jz};
+                        Vec3N q = p;
+                        for (int i = 0; i < 3; ++i) {
+                            if (idx[i] == kNoNode) continue;
+                            NodeId c = idx[i];
+                            if (j[i] != 0) {
+                                c = l.add(c, l.c(float(j[i])));
+                                if (s.kind == ShapeKind::RepeatFinite) c = l.clamp(c, l.neg(P(s, 3 + i)), P(s, 3 + i));
+                            }
+                            q[i] = l.sub(p[i], l.mul(per[i], c));
+                        }
+                        Lowered r = child(q);
+                        if (!have) {
+                            out = r;
+                            have = true;
+                        } else {
+                            if (inherited) out.m = select_mat(g, l.lt(out.d, r.d), out.m, r.m);
+                            out.d = l.mn(out.d, r.d);
+                        }
+                    }
             break;
         }
         case ShapeKind::PolarRepeat: {
-            // hg_sdf pModPolar around y; copy 0 points along +x.
+            // hg_sdf pModPolar around y; copy 0 points along +x. As for repeat, the copies of
+            // the neighbouring sectors that reach into this one are evaluated too.
             NodeId n = P(s, 0);
             NodeId ang = l.div(l.c(2 * kPi), n);
             NodeId a = l.add(g.binary(Op::Atan2, p[2], p[0]), l.mul(ang, l.c(0.5f)));
             NodeId r = l.len2(p[0], p[2]);
             a = l.sub(g.binary(Op::Mod, a, ang), l.mul(ang, l.c(0.5f)));
-            out = child({l.mul(g.unary(Op::Cos, a), r), p[1], l.mul(g.unary(Op::Sin, a), r)});
+            std::vector<int> js{0};
+            if (g.is_const(n)) js = polar_neighbours(shape_bounds(g, *s.children.at(0)), g.const_value(n));
+            bool have = false;
+            for (int j : js) {
+                NodeId aj = j == 0 ? a : l.sub(a, l.mul(ang, l.c(float(j))));
+                Lowered c = child({l.mul(g.unary(Op::Cos, aj), r), p[1], l.mul(g.unary(Op::Sin, aj), r)});
+                if (!have) {
+                    out = c;
+                    have = true;
+                } else {
+                    if (inherited) out.m = select_mat(g, l.lt(out.d, c.d), out.m, c.m);
+                    out.d = l.mn(out.d, c.d);
+                }
+            }
             break;
         }
         case ShapeKind::Symmetry: {

@@ -161,6 +161,36 @@ TEST_CASE("repeat: infinite is periodic; finite stops after count; a zero period
     CHECK(close(f2(0, 2, 0), 1.5));
 }
 
+// A child that reaches out of its cell is whole: the copies of the neighbouring cells that
+// reach into a cell are evaluated there too, so every copy is the child, not a cut piece.
+TEST_CASE("repeat and polar_repeat keep copies that reach out of their cell whole") {
+    auto spheres = [](float x, float y, float z, std::vector<std::array<float, 3>> cs, float r) {
+        float best = 1e30f;
+        for (auto& c : cs) best = std::min(best, std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) - r);
+        return best;
+    };
+    // Finite: copies at 0.9 + 2k for k = -2..2; each spans 0.4 + 2k .. 1.4 + 2k.
+    Field f("repeat([2, 0, 0], 2) translate([0.9, 0, 0]) sphere(0.5);");
+    CHECK(close(f(1.3f, 0, 0), -0.1f));
+    std::vector<std::array<float, 3>> fc;
+    for (int k = -2; k <= 2; ++k) fc.push_back({0.9f + 2.0f * k, 0, 0});
+    for_random_points(300, 6, [&](float x, float y, float z) { CHECK(close(f(x, y, z), spheres(x, y, z, fc, 0.5f), 1e-4)); });
+    // Infinite, on two axes, a child across a corner of its cell.
+    Field g("repeat([2, 0, 2]) translate([0.8, 0, -0.8]) sphere(0.4);");
+    CHECK(close(g(1.15f, 0, -0.8f), -0.05f));
+    CHECK(close(g(0.8f, 0, -1.15f), -0.05f));
+    CHECK(close(g(2.8f, 0, 1.2f), -0.4f));
+    // Polar: a child off copy 0's sector (+z, with 3 sectors centred on +x) is still there.
+    Field p("polar_repeat(3) translate([0, 0, 2]) sphere(0.5);");
+    CHECK(close(p(0, 0, 2), -0.5));
+    std::vector<std::array<float, 3>> pc;
+    for (int k = 0; k < 3; ++k) {
+        const float a = 3.14159265f / 2 + k * 2 * 3.14159265f / 3;  // copies at angles atan2(z, x)
+        pc.push_back({2 * std::cos(a), 0, 2 * std::sin(a)});
+    }
+    for_random_points(300, 4, [&](float x, float y, float z) { CHECK(close(p(x, y, z), spheres(x, y, z, pc, 0.5f), 1e-4)); });
+}
+
 TEST_CASE("polar_repeat is invariant under turns of 360/n about y") {
     Field p("polar_repeat(6) translate([2, 0, 0]) sphere(0.3);");
     CHECK(close(p(2, 0, 0), -0.3));
