@@ -167,6 +167,7 @@ Bounds shape_bounds(const Graph& g, const Shape& s) {
         case ShapeKind::Onion: return grow(child(), f(0));
         case ShapeKind::Displace: return grow(child(), f(0) * 1.5f);
         case ShapeKind::Material: return child();
+        case ShapeKind::Choose: return join(child(0), child(1));  // (its condition is never a constant)
     }
     return infinite();
 }

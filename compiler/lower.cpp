@@ -311,6 +311,15 @@ Lowered lower_shape(Graph& g, const Shape& s, const Vec3N& p, const MaterialN* i
             }
             break;
         }
+        case ShapeKind::Choose: {
+            // Both shapes, one distance chosen by a condition on time (constant per frame,
+            // so the result is as Lipschitz as the two).
+            Lowered a = lower_shape(g, *s.children.at(0), p, inherited), b = lower_shape(g, *s.children.at(1), p, inherited);
+            NodeId c = P(s, 0);
+            out = Lowered{l.sel(c, unit(g, a), unit(g, b)), 1.0f, {}};
+            if (inherited) out.m = select_mat(g, c, a.m, b.m);
+            break;
+        }
         case ShapeKind::Symmetry: {
             Vec3N q = p;
             for (int i = 0; i < 3; ++i)

@@ -31,6 +31,8 @@ MaterialN default_material(Graph& g);
     X(SmoothUnion) X(SmoothIntersection) X(SmoothDifference)                                   \
     X(ChamferUnion) X(ChamferIntersection) X(ChamferDifference)                                \
     X(StairsUnion) X(StairsIntersection) X(StairsDifference)                                   \
+    /* params[0] ? children[0] : children[1], a condition on time alone (GLSL's iTime) */      \
+    X(Choose)                                                                                  \
     /* modifiers: one child */                                                                  \
     X(Translate) X(Rotate) X(Scale) X(Mirror) X(Repeat) X(RepeatFinite) X(PolarRepeat)         \
     X(Symmetry) X(Elongate) X(Twist) X(Bend) X(Round) X(Onion) X(Displace) X(Material)

@@ -80,6 +80,7 @@ public:
     void run_for(const std::vector<ast::ForBinding>& bindings, Env* env, Loc loc, const std::function<void(Env*)>& body);
     ShapePtr to_shape(const Value& v, Loc loc, const char* what);
     ShapePtr union_of(std::vector<ShapePtr> shapes, Loc loc);
+    ShapePtr choose(NodeId cond, ShapePtr a, ShapePtr b, Loc loc);  // a Choose shape (cond on time alone)
 
     // --- builtins (builtins.cpp)
     Value call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>& args, Env* env, Loc loc);

@@ -127,6 +127,13 @@ ShapePtr Interp::union_of(std::vector<ShapePtr> shapes, Loc loc) {
     return make_shape(std::move(s));
 }
 
+ShapePtr Interp::choose(NodeId cond, ShapePtr a, ShapePtr b, Loc loc) {
+    Shape s{ShapeKind::Choose, loc};
+    s.params = {cond};
+    s.children = {std::move(a), std::move(b)};
+    return make_shape(std::move(s));
+}
+
 ShapePtr Interp::to_shape(const Value& v, Loc loc, const char* what) {
     if (v.t == VT::Shape) return v.shape;
     if (v.t == VT::None) return union_of({}, loc);
@@ -306,8 +313,8 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             for (Env* e = env; e; e = e->parent)
                 for (auto& [name, b] : e->vars)
                     if (b.mut) saved.emplace_back(&b, b.value);
-            std::vector<ShapePtr> shapes;
-            auto run_branch = [&](const ast::Stmt* br) {
+            std::vector<ShapePtr> then_shapes, else_shapes;
+            auto run_branch = [&](const ast::Stmt* br, std::vector<ShapePtr>& shapes) {
                 std::vector<Value> result;
                 if (br) {
                     Env* inner = new_env(env);
@@ -317,10 +324,14 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
                 for (auto& [b, v] : saved) b->value = v;
                 return result;
             };
-            std::vector<Value> then_vals = run_branch(s.then_branch.get());
-            std::vector<Value> else_vals = run_branch(s.else_branch.get());
-            if (!shapes.empty())
-                fail(s.value->loc, "a shape statement cannot depend on a condition on the point or time; use a field or min/max");
+            std::vector<Value> then_vals = run_branch(s.then_branch.get(), then_shapes);
+            std::vector<Value> else_vals = run_branch(s.else_branch.get(), else_shapes);
+            if (!then_shapes.empty() || !else_shapes.empty()) {
+                if (g->depends_on_point(cond))
+                    fail(s.value->loc, "a shape statement cannot depend on a condition on the point; use a field or min/max");
+                // On time alone (GLSL, where time is iTime): both branches, chosen per frame.
+                out.push_back(choose(cond, union_of(std::move(then_shapes), s.loc), union_of(std::move(else_shapes), s.loc), s.loc));
+            }
             for (size_t i = 0; i < saved.size(); ++i) {
                 const Value& a = then_vals[i];
                 const Value& b = else_vals[i];
@@ -512,6 +523,8 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             if (k) return eval(*e.elems[*k ? 1 : 2], env);
             NodeId cond = truth(c, e.elems[0]->loc);
             Value a = eval(*e.elems[1], env), b = eval(*e.elems[2], env);
+            if (a.t == VT::Shape && b.t == VT::Shape && !g->depends_on_point(cond))
+                return Value::of_shape(choose(cond, a.shape, b.shape, e.loc));  // on time alone
             if (!a.numeric() || a.t != b.t || a.n != b.n)
                 fail(e.loc, fmt::format("a choice on the point or time needs two numbers or vectors of one size, not {} and {}",
                                         describe(a), describe(b)));
@@ -522,7 +535,15 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
         case K::If: {
             Value c = eval(*e.elems[0], env);
             std::optional<bool> k = const_truth(c, e.elems[0]->loc);
-            if (!k) fail(e.elems[0]->loc, "a shape cannot be chosen by a condition on the point or time");
+            if (!k) {
+                NodeId cond = truth(c, e.elems[0]->loc);
+                if (g->depends_on_point(cond)) fail(e.elems[0]->loc, "a shape cannot be chosen by a condition on the point");
+                // On time alone (GLSL, where time is iTime): both branches, chosen per frame.
+                ShapePtr a = to_shape(eval(*e.elems[1], env), e.elems[1]->loc, "a branch");
+                ShapePtr b = e.elems.size() > 2 && e.elems[2] ? to_shape(eval(*e.elems[2], env), e.elems[2]->loc, "a branch")
+                                                              : union_of({}, e.loc);
+                return Value::of_shape(choose(cond, a, b, e.loc));
+            }
             if (*k) return eval(*e.elems[1], env);
             if (e.elems.size() > 2 && e.elems[2]) return eval(*e.elems[2], env);
             return Value::of_shape(union_of({}, e.loc));

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -337,4 +338,39 @@ TEST_CASE("glsl: the html page is self-contained", "[glsl][html]") {
     const std::string hs = html_shader(p2);
     for (char c : hs) CHECK(static_cast<unsigned char>(c) < 0x80);
     CHECK(hs.find("</") == std::string::npos);
+}
+
+// LANGUAGE.md: `time` may be used anywhere, and becomes iTime in GLSL. A shape chosen by a
+// condition on time compiles, with time symbolic, to both shapes and a select: the same
+// distances as the script run at each time.
+TEST_CASE("glsl: shapes chosen by a condition on time", "[glsl]") {
+    const char* scripts[] = {
+        "if (time > 1) sphere(1); else box(1);",
+        "time > 1 ? material(color = [1, 0, 0]) box(1) : translate([0.5, 0, 0]) sphere(2);",
+        "union { torus(1, 0.2); if (time < 0.5) { sphere(0.5); box(0.2); } }",
+    };
+    for (const char* src : scripts) {
+        INFO(src);
+        InterpretOptions symbolic;
+        symbolic.time = std::nullopt;
+        auto sym = test::compile_text(src, "scene.sdf", symbolic);
+        for (float t : {0.25f, 2.0f}) {
+            InterpretOptions at;
+            at.time = t;
+            auto fixed = test::compile_text(src, "scene.sdf", at);
+            for (auto [x, y, z] : {std::array<float, 3>{0.9f, 0.1f, 0.2f}, {1.6f, 0, 0}, {0, 1.2f, 0.4f}, {-2, 0.5f, 0}}) {
+                Evaluator ev(sym->cs.distance);
+                CHECK(ev.eval1(x, y, z, t) == Approx(test::dist(fixed->cs, x, y, z)).margin(1e-5));
+            }
+        }
+        const std::string g = glsl_of_text(src, GlslTarget::Shadertoy);
+        CHECK(g.find("sdf_time") != std::string::npos);
+        if (skip_without_validator()) continue;
+        const std::string e = validate(shadertoy_prelude(g), "readable");
+        INFO(e);
+        CHECK(e == "");
+    }
+    // On the point, a shape still cannot be chosen.
+    CHECK(test::first_error_line("field (p) -> { if (p.x > 0) sphere(1); p.x };") ==
+          "test.sdf:1:24: error: a shape statement cannot depend on a condition on the point; use a field or min/max");
 }
