@@ -75,7 +75,7 @@ std::vector<BuiltinInfo> make_table() {
         {opt("m", P::Material, 0), opt("color", P::Vec3, 0.8f, 0.8f, 0.8f), opt("specular", P::Num, 0.5f),
          opt("shininess", P::Num, 32), opt("reflect", P::Num, 0), opt("transparency", P::Num, 0), opt("ior", P::Num, 1.5f),
          opt("emission", P::Vec3, 0, 0, 0)});
-    add(B::Color, "color", K::MaterialCtor, {req("c", P::Vec)});
+    add(B::Color, "color", K::MaterialCtor, {req("color", P::Vec)});  // named like material's and ambient's
     // Settings
     add(B::Camera, "camera", K::Setting,
         {opt("position", P::Vec3, 0, 0, 5), opt("target", P::Vec3, 0, 0, 0), opt("up", P::Vec3, 0, 1, 0), opt("fov", P::Num, 45),

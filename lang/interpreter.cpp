@@ -566,7 +566,8 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             Value ix = eval(*e.rhs, env);
             if (v.t == VT::List) {
                 float i = const_num(ix, e.rhs->loc, "an index");
-                if (i < 0 || i >= float(v.list->size()) || i != std::floor(i))
+                if (i != std::floor(i)) fail(e.rhs->loc, fmt::format("index {} is not a whole number", i));
+                if (i < 0 || i >= float(v.list->size()))
                     fail(e.rhs->loc, fmt::format("index {} is out of range for a list of {}", i, v.list->size()));
                 return (*v.list)[size_t(i)];
             }
@@ -574,8 +575,8 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             NodeId in = num(ix, e.rhs->loc, "an index");
             if (g->is_const(in)) {
                 float i = g->const_value(in);
-                if (i < 0 || i >= v.n || i != std::floor(i))
-                    fail(e.rhs->loc, fmt::format("index {} is out of range for {}", i, describe(v)));
+                if (i != std::floor(i)) fail(e.rhs->loc, fmt::format("index {} is not a whole number", i));
+                if (i < 0 || i >= v.n) fail(e.rhs->loc, fmt::format("index {} is out of range for {}", i, describe(v)));
                 return Value::number(v.c[int(i)]);
             }
             NodeId r = v.c[v.n - 1];

@@ -100,3 +100,8 @@ TEST_CASE("var is for field blocks; let cannot be reassigned") {
           "test.sdf:1:27: error: 'd' is a constant (declared with let at line 1); declare it with var to reassign it");
     CHECK(first_error_line("let a = 1;\nlet a = 2;") == "test.sdf:2:5: error: 'a' is already defined in this scope (at line 1)");
 }
+
+TEST_CASE("an index must be a whole number within the vector or list") {
+    CHECK(first_error_line("sphere([1, 2, 3][1.5]);") == "test.sdf:1:18: error: index 1.5 is not a whole number");
+    CHECK(first_error_line("sphere([1, 2, 3][3]);") == "test.sdf:1:18: error: index 3 is out of range for a 3-component vector");
+}
