@@ -338,7 +338,7 @@ int cmd_eval(Args& a) {
     for (size_t i = 0; i < xs.size(); i += kBatch) {
         int n = int(std::min<size_t>(kBatch, xs.size() - i));
         ev.eval(&xs[i], &ys[i], &zs[i], n, cs.time);
-        for (int j = 0; j < n; ++j) out += fmt::format("{}\n", ev.output(0)[j]);
+        for (int j = 0; j < n; ++j) out += fmt::format("{}\n", ev.output(0)[j] + 0.0f);  // + 0: no "-0"
     }
     std::fwrite(out.data(), 1, out.size(), stdout);
     return 0;

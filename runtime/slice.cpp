@@ -45,6 +45,18 @@ Image render_slice(const CompiledScene& scene, const SliceOptions& opt) {
         if (!(v1 > v0)) { v0 = -5; v1 = 5; }
         float mu = 0.1f * (u1 - u0) + 0.05f, mv = 0.1f * (v1 - v0) + 0.05f;
         r = {u0 - mu, u1 + mu, v0 - mv, v1 + mv};
+        // Both sizes given: widen the range along one axis to the image's aspect, so that
+        // pixels stay square (a circle stays a circle).
+        if (opt.height > 0 && opt.width > 0) {
+            const float want = float(opt.width) / float(opt.height), have = (r[1] - r[0]) / (r[3] - r[2]);
+            if (have < want) {
+                const float grow = 0.5f * ((r[3] - r[2]) * want - (r[1] - r[0]));
+                r[0] -= grow, r[1] += grow;
+            } else {
+                const float grow = 0.5f * ((r[1] - r[0]) / want - (r[3] - r[2]));
+                r[2] -= grow, r[3] += grow;
+            }
+        }
     }
     int w = opt.width;
     int h = opt.height > 0 ? opt.height : std::max(1, int(std::lround(w * (r[3] - r[2]) / (r[1] - r[0]))));

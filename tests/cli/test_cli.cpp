@@ -34,6 +34,8 @@ TEST_CASE("eval prints one distance per line") {
     auto r2 = run_sdfc("eval '" + s + "' --points '" + pts + "'");
     CHECK(r2.status == 0);
     CHECK(r2.out == "0\n-1\n-1\n4\n");
+    std::string neg = test::write_temp("eval_neg.sdf", "field (p) -> -p.x;\n");
+    CHECK(run_sdfc("eval '" + neg + "' --at 0,0,0").out == "0\n");  // never "-0"
     auto bad = run_sdfc("eval '" + s + "' --at 1,2");
     CHECK(bad.status == 1);
     CHECK(bad.err == "sdfc: error: --at takes 3 comma-separated numbers, not '1,2'\n");
@@ -128,6 +130,21 @@ TEST_CASE("slice writes a cross-section picture") {
     REQUIRE(fs::exists(out));
     Image img = read_image(out);
     CHECK(img.width == 200);
+    // Width and height both given: pixels stay square, so a sphere's section is a circle.
+    std::string sph = test::write_temp("slice_sphere.sdf", "sphere(1);\n");
+    std::string out2 = test::temp_dir() + "/slice_sphere.png";
+    REQUIRE(run_sdfc("slice '" + sph + "' --axis z --at 0 -o '" + out2 + "' --width 160 --height 120").status == 0);
+    Image s2 = read_image(out2);
+    REQUIRE((s2.width == 160 && s2.height == 120));
+    auto inside = [&](int x, int y) {  // the palette: cool (blue over red) inside
+        const float* px = &s2.pixels[(size_t(y) * s2.width + x) * s2.channels];
+        return px[2] > px[0];
+    };
+    int across = 0, down = 0;
+    for (int x = 0; x < s2.width; ++x) across += inside(x, s2.height / 2);
+    for (int y = 0; y < s2.height; ++y) down += inside(s2.width / 2, y);
+    CHECK(across > 40);
+    CHECK(std::abs(across - down) <= 2);
 }
 
 namespace {
