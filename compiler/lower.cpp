@@ -256,10 +256,11 @@ Lowered lower_shape(Graph& g, const Shape& s, const Vec3N& p, const MaterialN* i
                 const float pe = g.const_value(per[i]), half = 0.5f * pe;  // > 0 (checked by repeat)
                 // Copy j of the neighbours spans [lo + j pe, hi + j pe]: those overlapping
                 // this cell, [-half, half]. At most kRepeatReach each side.
-                jlo[i] = std::max(-kRepeatReach, int(std::floor((-half - cb.hi[i]) / pe)) + 1);
-                jhi[i] = std::min(kRepeatReach, int(std::ceil((half - cb.lo[i]) / pe)) - 1);
-                jlo[i] = std::min(jlo[i], 0);
-                jhi[i] = std::max(jhi[i], 0);
+                // (Clamped as floats first: bounds of 1e28 over a period of 0.01 overflow an int.)
+                const float lo_j = std::floor((-half - cb.hi[i]) / pe) + 1, hi_j = std::ceil((half - cb.lo[i]) / pe) - 1;
+                if (!(pe > 0) || !std::isfinite(lo_j) || !std::isfinite(hi_j)) continue;
+                jlo[i] = int(std::clamp(lo_j, float(-kRepeatReach), 0.0f));
+                jhi[i] = int(std::clamp(hi_j, 0.0f, float(kRepeatReach)));
             }
             bool have = false;
             for (int jx = jlo[0]; jx <= jhi[0]; ++jx)
