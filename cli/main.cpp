@@ -113,7 +113,15 @@ std::string expand(std::string out, int frame, const std::string& name) {
     return out;
 }
 
-void apply_overrides(CompiledScene& cs, Args& a, Common& c) {
+// The scene flags a command took out of its arguments (flag, value if given): they override
+// the script's settings of each scene it compiles.
+using Overrides = std::vector<std::pair<std::string, std::optional<std::string>>>;
+
+void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
+    std::vector<std::string> flat;
+    for (auto& [k, v] : ov)
+        if (v) { flat.push_back(k); flat.push_back(*v); }
+    Args a(flat);
     bool sized = false;  // the size comes from flags, not (only) from the script
     if (auto v = a.value("--width")) cs.render.width = Args::to_int("--width", *v, 1, 65536), sized = true;
     if (auto v = a.value("--height")) cs.render.height = Args::to_int("--height", *v, 1, 65536), sized = true;
@@ -160,7 +168,7 @@ int cmd_render(Args& a) {
     bool quiet = a.flag("--quiet") || a.flag("-q");
     bool baseline = a.flag("--baseline");  // hidden: every acceleration off (issue 6)
     // Overrides are read per scene below; take them out of the positionals first.
-    std::vector<std::pair<std::string, std::optional<std::string>>> ov;
+    Overrides ov;
     for (const char* f : {"--width", "--height", "--samples", "--camera-position", "--camera-target", "--fov"}) ov.emplace_back(f, a.value(f));
     auto scenes = a.positionals();
     if (scenes.empty()) throw UsageError("render needs a scene file");
@@ -213,11 +221,7 @@ int cmd_render(Args& a) {
             for (auto& x : d) x.message += fmt::format(" (at frame {}, time {})", f, t);
             throw CompileError(std::move(d));
         }
-        std::vector<std::string> flat;
-        for (auto& [k, v] : ov)
-            if (v) { flat.push_back(k); flat.push_back(*v); }
-        Args overrides(flat);
-        apply_overrides(cs, overrides, c);
+        apply_overrides(cs, ov, c);
         return cs;
     };
     // With several outputs, every frame of every scene compiles before the first image is
@@ -406,17 +410,13 @@ int cmd_bench(Args& a) {
     auto repeat = a.value("--repeat");
     auto threads = a.value("--threads");
     bool baseline = a.flag("--baseline");
-    std::vector<std::pair<std::string, std::optional<std::string>>> ov;
+    Overrides ov;
     for (const char* f : {"--width", "--height", "--samples"}) ov.emplace_back(f, a.value(f));
     std::string path = one_scene(a, "bench");
     int n = repeat ? Args::to_int("--repeat", *repeat, 1, 100000) : 5;
     SourceManager sm;
     CompiledScene cs = build(sm, path, c, 0.0f);
-    std::vector<std::string> flat;
-    for (auto& [k, v] : ov)
-        if (v) { flat.push_back(k); flat.push_back(*v); }
-    Args overrides(flat);
-    apply_overrides(cs, overrides, c);
+    apply_overrides(cs, ov, c);
     RenderOptions ro;
     if (threads) ro.threads = Args::to_int("--threads", *threads, 1, 1024);
     ro.baseline = baseline;

@@ -67,6 +67,14 @@ MaterialN select_mat(Graph& g, NodeId cond, const MaterialN& a, const MaterialN&
     return m;
 }
 
+// The nearer of two lowered shapes with the same Lipschitz bound (a's on ties), with its
+// material when materials are lowered.
+Lowered nearer(L& l, const Lowered& a, const Lowered& b, bool materials) {
+    Lowered r{l.mn(a.d, b.d), a.lip, {}};
+    if (materials) r.m = select_mat(l.g, l.lt(a.d, b.d), a.m, b.m);
+    return r;
+}
+
 float bound_radius(const Bounds& b) {
     if (!b.finite()) return 10.0f;  // unbounded child: assume the working volume of a scene
     glm::vec3 e = glm::max(glm::abs(b.lo), glm::abs(b.hi));
@@ -262,7 +270,7 @@ Lowered lower_shape(Graph& g, const Shape& s, const Vec3N& p, const MaterialN* i
                 jlo[i] = int(std::clamp(lo_j, float(-kRepeatReach), 0.0f));
                 jhi[i] = int(std::clamp(hi_j, 0.0f, float(kRepeatReach)));
             }
-            bool have = false;
+            std::optional<Lowered> acc;  // the copies are one child: one Lipschitz bound
             for (int jx = jlo[0]; jx <= jhi[0]; ++jx)
                 for (int jy = jlo[1]; jy <= jhi[1]; ++jy)
                     for (int jz = jlo[2]; jz <= jhi[2]; ++jz) {
@@ -278,14 +286,9 @@ Lowered lower_shape(Graph& g, const Shape& s, const Vec3N& p, const MaterialN* i
                             q[i] = l.sub(p[i], l.mul(per[i], c));
                         }
                         Lowered r = child(q);
-                        if (!have) {
-                            out = r;
-                            have = true;
-                        } else {
-                            if (inherited) out.m = select_mat(g, l.lt(out.d, r.d), out.m, r.m);
-                            out.d = l.mn(out.d, r.d);
-                        }
+                        acc = acc ? nearer(l, *acc, r, inherited) : r;
                     }
+            out = *acc;
             break;
         }
         case ShapeKind::PolarRepeat: {
@@ -298,18 +301,13 @@ Lowered lower_shape(Graph& g, const Shape& s, const Vec3N& p, const MaterialN* i
             a = l.sub(g.binary(Op::Mod, a, ang), l.mul(ang, l.c(0.5f)));
             std::vector<int> js{0};
             if (g.is_const(n)) js = polar_neighbours(shape_bounds(g, *s.children.at(0)), g.const_value(n));
-            bool have = false;
+            std::optional<Lowered> acc;
             for (int j : js) {
                 NodeId aj = j == 0 ? a : l.sub(a, l.mul(ang, l.c(float(j))));
                 Lowered c = child({l.mul(g.unary(Op::Cos, aj), r), p[1], l.mul(g.unary(Op::Sin, aj), r)});
-                if (!have) {
-                    out = c;
-                    have = true;
-                } else {
-                    if (inherited) out.m = select_mat(g, l.lt(out.d, c.d), out.m, c.m);
-                    out.d = l.mn(out.d, c.d);
-                }
+                acc = acc ? nearer(l, *acc, c, inherited) : c;
             }
+            out = *acc;
             break;
         }
         case ShapeKind::Choose: {
@@ -646,10 +644,8 @@ std::optional<Lowered> lower_union_spatial(L& l, const Shape& s, const Vec3N& p,
         // Deterministic: ties in a coordinate keep the children's order.
         std::stable_sort(first, last, [&](uint32_t a, uint32_t b) { return centre[a][axis] < centre[b][axis]; });
         uint32_t* mid = first + (last - first) / 2;
-        const Lowered a = self(self, first, mid), b = self(self, mid, last);
-        Lowered r{l.mn(a.d, b.d), 1.0f, {}};
-        if (inherited) r.m = select_mat(g, l.lt(a.d, b.d), a.m, b.m);
-        return r;
+        const Lowered a = self(self, first, mid), b = self(self, mid, last);  // in this order: node numbering
+        return nearer(l, a, b, inherited);
     };
     return build(build, order.data(), order.data() + order.size());
 }
