@@ -178,6 +178,11 @@ TEST_CASE("materials are values and modifiers; the inner one wins") {
     auto b = mat_at(-3);
     CHECK(b[3] == Approx(1));
     CHECK(b[1] == Approx(0));
+    // color's parameter is named like material's.
+    auto named = test::compile_text("color(color = [0, 1, 0]) sphere(1);");
+    auto gr = eval_scalar(named->cs.shading, 0, 0, 0);
+    CHECK(gr[2] == Approx(1));
+    CHECK(gr[1] == Approx(0));
 }
 
 TEST_CASE("materials blend across smooth operations") {
