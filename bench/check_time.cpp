@@ -9,7 +9,7 @@
 
 #include <time.h>
 
-#include "compiler/compile.hpp"
+#include "compiler/bytecode/compile.hpp"
 #include "lang/load.hpp"
 
 using namespace sdfc;

@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <cstdio>
 
-#include "runtime/image.hpp"
+#include "runtime/io/image.hpp"
 
 using namespace sdfc;
 

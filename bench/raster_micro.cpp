@@ -10,9 +10,9 @@
 
 #include <time.h>
 
-#include "compiler/compile.hpp"
+#include "compiler/bytecode/compile.hpp"
 #include "lang/load.hpp"
-#include "runtime/slice.hpp"
+#include "runtime/cpu/slice.hpp"
 
 using namespace sdfc;
 

@@ -9,9 +9,9 @@
 
 #include <time.h>
 
-#include "compiler/compile.hpp"
+#include "compiler/bytecode/compile.hpp"
 #include "lang/load.hpp"
-#include "runtime/vm.hpp"
+#include "runtime/eval/vm.hpp"
 
 using namespace sdfc;
 

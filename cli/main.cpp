@@ -14,16 +14,16 @@
 #include <fmt/format.h>
 
 #include "cli/args.hpp"
-#include "compiler/compile.hpp"
-#include "compiler/glsl.hpp"
-#include "compiler/lower.hpp"
+#include "compiler/bytecode/compile.hpp"
+#include "compiler/glsl/glsl.hpp"
+#include "compiler/scene/lower.hpp"
 #include "lang/ast.hpp"
 #include "lang/load.hpp"
-#include "runtime/atomic_file.hpp"
-#include "runtime/image.hpp"
-#include "runtime/slice.hpp"
-#include "runtime/tracer.hpp"
-#include "runtime/vm.hpp"
+#include "runtime/io/atomic_file.hpp"
+#include "runtime/io/image.hpp"
+#include "runtime/cpu/slice.hpp"
+#include "runtime/cpu/tracer.hpp"
+#include "runtime/eval/vm.hpp"
 
 #ifndef SDFC_VERSION
 #define SDFC_VERSION "0.0.0"
@@ -503,7 +503,7 @@ int run(int argc, char** argv) {
 // The command runs on a thread with a big stack: the interpreter and the compiler recurse
 // once per level of a deep (legal) script, and the main thread's 8 MB can run out before
 // the limits do, especially with raised limits or under sanitizers. 1 GiB of address space,
-// touched only as deep as the script goes; the stack guard (lang/source.hpp) still stops
+// touched only as deep as the script goes; the stack guard (compiler/base/source.hpp) still stops
 // anything deeper with a located error.
 int main(int argc, char** argv) {
     int rc = 1;

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "lang/source.hpp"
+#include "compiler/base/source.hpp"
 
 namespace sdfc::ast {
 

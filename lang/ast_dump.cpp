@@ -84,7 +84,7 @@ struct Dumper {
             line(d, "(none)");
             return;
         }
-        check_stack(e->loc);  // trees as tall as the parser allows (see lang/source.hpp)
+        check_stack(e->loc);  // trees as tall as the parser allows (see compiler/base/source.hpp)
         switch (e->kind) {
             case ExprKind::Number: line(d, fmt::format("number {}", e->number)); break;
             case ExprKind::Bool: line(d, e->boolean ? "bool true" : "bool false"); break;

@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "compiler/lower.hpp"
+#include "compiler/scene/lower.hpp"
 #include "lang/interp.hpp"
 
 namespace sdfc {

@@ -5,8 +5,8 @@
 #include <optional>
 #include <string>
 
-#include "compiler/scene.hpp"
-#include "lang/source.hpp"
+#include "compiler/scene/scene.hpp"
+#include "compiler/base/source.hpp"
 
 namespace sdfc {
 

@@ -1177,7 +1177,7 @@ std::unique_ptr<Module> parse_on_this_stack(const SourceFile& file, unsigned max
 // The stack a parse on its own thread gets: this much per nesting level, far more than any
 // build uses (a level is a few dozen PEGTL frames: about 1 KB in Release, 8-12 KB under
 // AddressSanitizer), plus a base. It is address space, touched only as deep as the input
-// goes. Bounded by max_thread_stack() (lang/source.cpp, smaller in sanitizer builds);
+// goes. Bounded by max_thread_stack() (compiler/base/source.cpp, smaller in sanitizer builds);
 // beyond it the stack guard reports the input as too deeply nested.
 constexpr size_t kStackPerLevel = 64u << 10;
 constexpr size_t kStackBase = 8u << 20;

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "compiler/scene.hpp"
+#include "compiler/scene/scene.hpp"
 #include "lang/ast.hpp"
 
 namespace sdfc {

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <string>
 
-#include "compiler/compile.hpp"
+#include "compiler/bytecode/compile.hpp"
 #include "lang/interpreter.hpp"
-#include "runtime/image.hpp"
-#include "runtime/vm.hpp"
+#include "runtime/io/image.hpp"
+#include "runtime/eval/vm.hpp"
 
 namespace sdfc::test {
 

@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "run.hpp"
-#include "runtime/image.hpp"
+#include "runtime/io/image.hpp"
 
 using namespace sdfc;
 using test::run_sdfc;

@@ -14,7 +14,7 @@
 
 #include "run.hpp"
 #include "support.hpp"
-#include "runtime/image.hpp"
+#include "runtime/io/image.hpp"
 
 using namespace sdfc;
 using test::run_sdfc;

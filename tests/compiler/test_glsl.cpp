@@ -17,8 +17,8 @@
 
 #include <fmt/format.h>
 
-#include "compiler/glsl.hpp"
-#include "compiler/glsl_emit.hpp"
+#include "compiler/glsl/glsl.hpp"
+#include "compiler/glsl/glsl_emit.hpp"
 #include "lang/load.hpp"
 #include "support.hpp"
 

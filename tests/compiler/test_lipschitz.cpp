@@ -5,10 +5,10 @@
 #include <filesystem>
 #include <random>
 
-#include "compiler/compile.hpp"
-#include "compiler/op_math.hpp"
+#include "compiler/bytecode/compile.hpp"
+#include "compiler/ir/op_math.hpp"
 #include "lang/load.hpp"
-#include "runtime/vm.hpp"
+#include "runtime/eval/vm.hpp"
 
 using namespace sdfc;
 namespace fs = std::filesystem;

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <string>
 
-#include "compiler/program.hpp"
-#include "runtime/vm.hpp"
+#include "compiler/bytecode/program.hpp"
+#include "runtime/eval/vm.hpp"
 #include "support.hpp"
 
 using namespace sdfc;

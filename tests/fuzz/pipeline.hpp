@@ -16,12 +16,12 @@
 
 #include <fmt/format.h>
 
-#include "compiler/compile.hpp"
-#include "compiler/glsl.hpp"
+#include "compiler/bytecode/compile.hpp"
+#include "compiler/glsl/glsl.hpp"
 #include "lang/ast.hpp"
 #include "lang/interpreter.hpp"
 #include "lang/load.hpp"
-#include "runtime/vm.hpp"
+#include "runtime/eval/vm.hpp"
 
 namespace sdfc::fuzz {
 

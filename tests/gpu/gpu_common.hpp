@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "compiler/compile.hpp"
-#include "compiler/glsl.hpp"
+#include "compiler/bytecode/compile.hpp"
+#include "compiler/glsl/glsl.hpp"
 #include "lang/load.hpp"
-#include "runtime/image.hpp"
-#include "runtime/tracer.hpp"
+#include "runtime/io/image.hpp"
+#include "runtime/cpu/tracer.hpp"
 
 namespace sdfc::gpu_test {
 
@@ -35,7 +35,7 @@ inline std::vector<std::string> examples() {
     return out;
 }
 
-inline uint8_t to_u8(float display) {  // as runtime/image.cpp writes 8-bit files
+inline uint8_t to_u8(float display) {  // as runtime/io/image.cpp writes 8-bit files
     if (!(display > 0.0f)) return 0;
     if (display >= 1.0f) return 255;
     return static_cast<uint8_t>(display * 255.0f + 0.5f);

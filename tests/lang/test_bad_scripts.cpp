@@ -3,7 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "bad_corpus.hpp"
-#include "compiler/compile.hpp"
+#include "compiler/bytecode/compile.hpp"
 #include "lang/load.hpp"
 
 using namespace sdfc;

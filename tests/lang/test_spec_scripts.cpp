@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "compiler/compile.hpp"
+#include "compiler/bytecode/compile.hpp"
 #include "lang/interpreter.hpp"
 
 using namespace sdfc;

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "lang/load.hpp"
-#include "runtime/tracer.hpp"
+#include "runtime/cpu/tracer.hpp"
 #include "support.hpp"
 
 using namespace sdfc;

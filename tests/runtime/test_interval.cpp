@@ -1,4 +1,4 @@
-// Interval arithmetic (runtime/interval.hpp): every opcode's interval encloses what the
+// Interval arithmetic (runtime/eval/interval.hpp): every opcode's interval encloses what the
 // batch VM computes at every point of the box, bit for bit, and a decided choice is the
 // VM's choice at every point; simplified tapes compute the same floats as their parent
 // inside the box.
@@ -9,10 +9,10 @@
 #include <limits>
 #include <random>
 
-#include "compiler/compile.hpp"
+#include "compiler/bytecode/compile.hpp"
 #include "lang/load.hpp"
-#include "runtime/interval.hpp"
-#include "runtime/vm.hpp"
+#include "runtime/eval/interval.hpp"
+#include "runtime/eval/vm.hpp"
 #include "support.hpp"
 
 using namespace sdfc;

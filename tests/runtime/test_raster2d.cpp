@@ -4,9 +4,9 @@
 
 #include <filesystem>
 
-#include "compiler/compile.hpp"
+#include "compiler/bytecode/compile.hpp"
 #include "lang/load.hpp"
-#include "runtime/slice.hpp"
+#include "runtime/cpu/slice.hpp"
 
 using namespace sdfc;
 namespace fs = std::filesystem;

@@ -14,10 +14,10 @@
 #include <fstream>
 #include <functional>
 
-#include "compiler/compile.hpp"
-#include "runtime/camera.hpp"
-#include "runtime/image.hpp"
-#include "runtime/tracer.hpp"
+#include "compiler/bytecode/compile.hpp"
+#include "compiler/render/camera.hpp"
+#include "runtime/io/image.hpp"
+#include "runtime/cpu/tracer.hpp"
 
 using namespace sdfc;
 namespace fs = std::filesystem;

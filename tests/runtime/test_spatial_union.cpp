@@ -1,4 +1,4 @@
-// Unions of many bounded shapes are lowered as a k-d min tree (compiler/lower.cpp,
+// Unions of many bounded shapes are lowered as a k-d min tree (compiler/scene/lower.cpp,
 // lower_union_spatial): the same distances as the script's chain, and much shorter
 // programs once interval arithmetic simplifies them over a small box.
 #include <catch2/catch.hpp>
@@ -7,7 +7,7 @@
 #include <random>
 #include <string>
 
-#include "runtime/interval.hpp"
+#include "runtime/eval/interval.hpp"
 #include "support.hpp"
 
 using namespace sdfc;

@@ -1,0 +1,88 @@
+// Source files, locations and diagnostics: every stage reports through these, so any
+// error a script causes reads `path:line:col: error: message`, the line, and a caret.
+#pragma once
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sdfc {
+
+struct SourceFile {
+    std::string path;   // as the user named it (or as resolved for imports)
+    std::string text;
+    std::vector<size_t> line_starts;  // offset of each line's first byte
+
+    SourceFile(std::string path, std::string text);
+    std::string_view line(uint32_t n) const;  // 1-based, without the newline
+};
+
+// A point in a script. Cheap to copy; the file outlives every Loc (SourceManager owns it).
+struct Loc {
+    const SourceFile* file = nullptr;
+    uint32_t line = 0;  // 1-based; 0 = unknown
+    uint32_t col = 0;   // 1-based, in bytes
+    bool known() const { return file != nullptr && line != 0; }
+};
+
+struct Diagnostic {
+    Loc loc;
+    std::string message;
+};
+
+// `path:line:col: error: message`, the source line, a caret under the column.
+std::string format_diagnostic(const Diagnostic& d);
+
+// Thrown by any stage for errors the user caused. Holds one or more diagnostics.
+class CompileError : public std::runtime_error {
+public:
+    explicit CompileError(std::vector<Diagnostic> diags);
+    CompileError(Loc loc, std::string message);
+    // Locations point into files that may be gone once the error has propagated out of
+    // the stage that loaded them: use them only while that stage is alive.
+    const std::vector<Diagnostic>& diagnostics() const { return diags_; }
+    // All diagnostics, each formatted, joined; rendered when thrown, so always safe.
+    const std::string& formatted() const { return formatted_; }
+
+private:
+    std::vector<Diagnostic> diags_;
+    std::string formatted_;
+};
+
+// Throws CompileError at the first NUL byte (a binary file) or invalid UTF-8 sequence.
+void check_source_text(const SourceFile& f);
+
+// Owns every loaded file so Locs stay valid for the whole compilation.
+class SourceManager {
+public:
+    // Reads a file; throws CompileError at `from` (the import or command line) on failure,
+    // or for binary/invalid UTF-8 content or a file over `max_bytes`.
+    const SourceFile& load(const std::string& path, Loc from = {}, size_t max_bytes = 16u << 20);
+    const SourceFile& add(std::string path, std::string text);
+
+private:
+    std::deque<std::unique_ptr<SourceFile>> files_;
+};
+
+// Levenshtein-nearest candidate within a small distance, or "" (for "did you mean").
+std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates);
+
+// Every recursive stage (parser, interpreter, lowering) calls this once per level: it
+// throws CompileError at `loc` when the current thread's C++ stack is nearly used up, so
+// input nested deeper than the stack allows is a diagnostic, never a stack overflow,
+// whatever the limits (--max-nesting, --max-recursion, --max-shape-depth) are raised to.
+void check_stack(Loc loc);
+bool stack_nearly_exhausted();  // the test alone (when making the Loc costs something)
+
+// The most stack this build gives a thread of its own: 4 GiB of address space (touched
+// only as deep as the input goes), less under sanitizers (see compiler/base/source.cpp).
+size_t max_thread_stack();
+// Runs `fn` on a new thread with a stack of `bytes` and waits for it; false (fn not run)
+// when no such thread can be made. `fn` must not throw.
+bool run_on_new_stack(size_t bytes, const std::function<void()>& fn);
+
+}  // namespace sdfc

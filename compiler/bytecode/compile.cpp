@@ -1,0 +1,122 @@
+// Scene -> CompiledScene: lower both roots, generate the two programs, resolve settings.
+#include "compiler/bytecode/compile.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "compiler/scene/lower.hpp"
+
+namespace sdfc {
+
+LoweredScene lower_scene(Graph& g, const Scene& scene) {
+    Vec3N p{g.input(Op::VarX), g.input(Op::VarY), g.input(Op::VarZ)};
+    LoweredScene out;
+    // One pass gives both: the distance nodes are the same with or without materials.
+    MaterialN base = default_material(g);
+    Lowered l = lower_shape(g, *scene.root, p, &base);
+    out.distance = out.shading_distance = l.lip == 1.0f ? l.d : g.mulc(l.d, 1.0f / l.lip);
+    out.material = l.m;
+    return out;
+}
+
+namespace {
+
+float constant(const Graph& g, NodeId n, Loc loc, const char* what) {
+    if (n == kNoNode) throw CompileError(loc, fmt::format("internal: {} is unset", what));
+    if (!g.is_const(n)) throw CompileError(loc, fmt::format("{} must be a constant here", what));
+    if (!std::isfinite(g.const_value(n))) throw CompileError(loc, fmt::format("{} is not a finite number", what));
+    return g.const_value(n);
+}
+glm::vec3 constant3(const Graph& g, const Vec3N& v, Loc loc, const char* what) {
+    return {constant(g, v[0], loc, what), constant(g, v[1], loc, what), constant(g, v[2], loc, what)};
+}
+
+// Script constants are checked as the interpreter computes them, but lowering folds more
+// (a gyroid's 2*pi/period, a normal divided by its length...), which can still overflow:
+// a NaN or infinite constant in a program is an error at the line that made it.
+void check_constants(const Program& p) {
+    for (size_t i = 0; i < p.code.size(); ++i) {
+        const Instr& in = p.code[i];
+        if (op_info(in.op).has_imm && !std::isfinite(in.k))
+            throw CompileError(i < p.locs.size() ? p.locs[i] : Loc{},
+                               fmt::format("this expression is not a finite number ({})", in.k));
+    }
+}
+
+}  // namespace
+
+CompiledScene compile_scene(const Scene& scene) {
+    Graph& g = *scene.graph;
+    CompiledScene cs;
+    LoweredScene ls = lower_scene(g, scene);
+    cs.distance = codegen(g, {ls.distance}, {"d"});
+    std::vector<NodeId> roots{ls.shading_distance};
+    std::vector<std::string> names{"d", "r", "g", "b", "specular", "shininess", "reflect", "transparency", "ior",
+                                   "emit_r", "emit_g", "emit_b"};
+    for (NodeId m : ls.material) roots.push_back(m);
+    cs.shading = codegen(g, roots, names);
+    check_constants(cs.distance);
+    check_constants(cs.shading);
+
+    const CameraSettings& c = scene.camera;
+    cs.camera.position = constant3(g, c.position, c.loc, "the camera position");
+    cs.camera.target = constant3(g, c.target, c.loc, "the camera target");
+    cs.camera.up = constant3(g, c.up, c.loc, "the camera up vector");
+    cs.camera.fov = constant(g, c.fov, c.loc, "the camera fov");
+    cs.camera.orthographic = c.orthographic;
+    cs.camera.ortho_height = constant(g, c.ortho_height, c.loc, "the camera ortho_height");
+    // A view direction and a right vector must exist, or every ray is NaN.
+    const glm::vec3 view = cs.camera.target - cs.camera.position;
+    if (!(glm::length(view) > 0.0f))
+        throw CompileError(c.loc, "the camera's position and target are the same point");
+    if (!(glm::length(glm::cross(glm::normalize(view), glm::normalize(cs.camera.up))) > 1e-5f))
+        throw CompileError(c.loc, "the camera's up vector must not be zero or parallel to the view direction");
+    for (const LightSettings& l : scene.lights) {
+        ResolvedLight r;
+        r.directional = l.directional;
+        if (l.directional) {
+            glm::vec3 d = constant3(g, l.direction, l.loc, "the light direction");
+            r.direction = glm::length(d) > 0 ? glm::normalize(d) : glm::vec3(0, -1, 0);
+        } else {
+            r.position = constant3(g, l.position, l.loc, "the light position");
+        }
+        r.color = constant3(g, l.color, l.loc, "the light color");
+        r.intensity = constant(g, l.intensity, l.loc, "the light intensity");
+        r.radius = constant(g, l.radius, l.loc, "the light radius");
+        cs.lights.push_back(r);
+    }
+    if (cs.lights.empty()) {
+        // Default rig: a key light over the camera's shoulder and a dim fill from the other side.
+        ResolvedLight key;
+        key.directional = true;
+        glm::vec3 fwd = glm::normalize(cs.camera.target - cs.camera.position);
+        glm::vec3 right = glm::normalize(glm::cross(fwd, cs.camera.up));
+        key.direction = glm::normalize(fwd + 0.6f * right - 1.2f * glm::normalize(cs.camera.up));
+        key.color = glm::vec3(1.0f, 0.97f, 0.92f);
+        key.intensity = 1.0f;
+        ResolvedLight fill = key;
+        fill.direction = glm::normalize(fwd - 0.8f * right - 0.3f * glm::normalize(cs.camera.up));
+        fill.color = glm::vec3(0.55f, 0.6f, 0.7f);
+        fill.intensity = 0.35f;
+        cs.lights = {key, fill};
+    }
+    cs.ambient = constant3(g, scene.ambient, c.loc, "the ambient color");
+    cs.background = constant3(g, scene.background, c.loc, "the background color");
+    cs.render = scene.render;
+    cs.bounds = shape_bounds(g, *scene.root);
+    if (!cs.bounds.finite() && !scene.raw_field) {
+        Bounds box{glm::vec3(1e30f), glm::vec3(-1e30f)};
+        std::vector<glm::vec4> half_spaces;
+        if (clip_regions(g, *scene.root, box, half_spaces) && !half_spaces.empty()) {
+            cs.solid_bounds = box;
+            cs.half_spaces = std::move(half_spaces);
+        }
+    }
+    cs.is_2d = scene.is_2d;
+    cs.raw_field = scene.raw_field;
+    cs.time = scene.time;
+    return cs;
+}
+
+}  // namespace sdfc

@@ -1,0 +1,59 @@
+// The compiler's front door: Scene (shape tree + settings) -> CompiledScene (immutable
+// programs + settings resolved to numbers for the CPU renderer).
+//
+//   Scene --lower (compiler/scene/lower.cpp)--> IR Graph --codegen (compiler/bytecode/codegen.cpp)--> Program
+#pragma once
+#include <glm/glm.hpp>
+#include <string>
+#include <vector>
+
+#include "compiler/bytecode/program.hpp"
+#include "compiler/scene/scene.hpp"
+
+namespace sdfc {
+
+struct ResolvedCamera {
+    glm::vec3 position{0, 0, 5}, target{0, 0, 0}, up{0, 1, 0};
+    float fov = 45.0f;  // vertical, degrees
+    bool orthographic = false;
+    float ortho_height = 2.0f;
+};
+
+struct ResolvedLight {
+    bool directional = false;
+    glm::vec3 position{0}, direction{0, -1, 0};  // direction: where the light travels (normalised)
+    glm::vec3 color{1};
+    float intensity = 1.0f;
+    float radius = 0.0f;
+};
+
+struct CompiledScene {
+    Program distance;  // outputs: "d", a 1-Lipschitz bound of the distance
+    Program shading;   // outputs: "d", then the kMatChannels material channels
+    ResolvedCamera camera;
+    std::vector<ResolvedLight> lights;  // never empty: defaults when the script has none
+    glm::vec3 ambient{0.05f}, background{0.0f};
+    RenderSettings render;
+    Bounds bounds;
+    // When `bounds` is infinite because of floor planes (clip_regions, compiler/scene/lower.hpp):
+    // every surface lies in solid_bounds (possibly empty) or in one of these half-spaces
+    // n.p <= w (unit n). Empty otherwise.
+    Bounds solid_bounds;
+    std::vector<glm::vec4> half_spaces;
+    bool is_2d = false;
+    bool raw_field = false;
+    float time = 0.0f;
+};
+
+// Throws CompileError (at the setting's location) if a setting is not a constant.
+CompiledScene compile_scene(const Scene& scene);
+
+// The two IR roots compile_scene turns into programs (also used by the GLSL emitter).
+struct LoweredScene {
+    NodeId distance;
+    NodeId shading_distance;
+    MaterialN material;
+};
+LoweredScene lower_scene(Graph& g, const Scene& scene);
+
+}  // namespace sdfc

@@ -1,0 +1,333 @@
+// The GLSL backend. Layout of every target's shader:
+//
+//   header comment (what it is, how to use it, the uniforms)
+//   render settings as constants          SDF_MAX_STEPS, SDF_EPSILON, ... (render(...) of the script)
+//   kRendererHead                         struct Material, struct SdfLight, setting globals
+//   sdf_noise (only if the scene uses it) compiler/ir/op_math.hpp's kGlslNoise
+//   float map(vec3 p)                     the distance program (compiler/bytecode/codegen.cpp)
+//   Material sdf_material(vec3 p)         the 11 material channels
+//   void sdf_settings()                   camera, lights, ambient, background (may use sdf_time)
+//   kRendererBody                         the renderer, a twin of runtime/cpu/tracer.cpp
+//   the target's entry point              mainImage / main
+//
+// The three scene functions are generated from register Programs made by the same codegen as
+// the VM's, one instruction at a time through opcodes.def's GLSL templates (glsl_emit.cpp).
+#include "compiler/glsl/glsl.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "compiler/bytecode/compile.hpp"
+#include "compiler/glsl/glsl_emit.hpp"
+#include "compiler/glsl/glsl_html.hpp"
+#include "compiler/glsl/glsl_renderer.hpp"
+#include "compiler/scene/lower.hpp"
+
+namespace sdfc {
+namespace {
+
+using glsl::literal;
+
+std::string vec3_lit(float x, float y, float z) {
+    return fmt::format("vec3({}, {}, {})", literal(x), literal(y), literal(z));
+}
+
+float radical_inverse2(uint32_t i) {  // as runtime/cpu/tracer.cpp
+    i = (i << 16) | (i >> 16);
+    i = ((i & 0x55555555u) << 1) | ((i & 0xAAAAAAAAu) >> 1);
+    i = ((i & 0x33333333u) << 2) | ((i & 0xCCCCCCCCu) >> 2);
+    i = ((i & 0x0F0F0F0Fu) << 4) | ((i & 0xF0F0F0F0u) >> 4);
+    i = ((i & 0x00FF00FFu) << 8) | ((i & 0xFF00FF00u) >> 8);
+    return static_cast<float>(i) * 2.3283064365386963e-10f;
+}
+
+// The script's name, for the header comment.
+std::string script_name(const Scene& s) {
+    for (Loc l : {s.root ? s.root->loc : Loc{}, s.camera.loc, s.render.loc})
+        if (l.file) return glsl::comment_text(std::filesystem::path(l.file->path).filename().string());
+    for (const LightSettings& l : s.lights)
+        if (l.loc.file) return glsl::comment_text(std::filesystem::path(l.loc.file->path).filename().string());
+    return "scene";
+}
+
+glm::vec3 const3(const Graph& g, const Vec3N& v, glm::vec3 dflt) {
+    glm::vec3 r = dflt;
+    for (int i = 0; i < 3; ++i)
+        if (v[i] != kNoNode && g.is_const(v[i])) r[i] = g.const_value(v[i]);
+    return r;
+}
+
+// A Lipschitz estimate for a raw field over a box, as runtime/cpu/tracer.cpp makes it: the largest
+// gradient norm (forward differences) on a 16^3 grid among the tenth of the points with the
+// smallest |f|, times 1.5.
+float estimate_lipschitz(const Program& prog, const glm::vec3& lo, const glm::vec3& hi) {
+    constexpr int kGrid = 16;
+    const glm::vec3 ext = hi - lo;
+    const float m = std::max(ext.x, std::max(ext.y, ext.z));
+    if (!std::isfinite(m)) return 1.0f;
+    const float e = 1e-3f * std::max(m, 1e-6f);
+    std::vector<std::pair<float, float>> samples;  // (|f|, |grad f|)
+    for (int k = 0; k < kGrid; ++k)
+        for (int j = 0; j < kGrid; ++j)
+            for (int i = 0; i < kGrid; ++i) {
+                const glm::vec3 p = lo + ext * (glm::vec3(i, j, k) + 0.5f) / static_cast<float>(kGrid);
+                float f[4];
+                for (int q = 0; q < 4; ++q)
+                    f[q] = eval_scalar(prog, p.x + (q == 1 ? e : 0.0f), p.y + (q == 2 ? e : 0.0f), p.z + (q == 3 ? e : 0.0f), 0.0f)[0];
+                const glm::vec3 gr(f[1] - f[0], f[2] - f[0], f[3] - f[0]);
+                const float gn = glm::length(gr) / e;
+                if (std::isfinite(gn) && std::isfinite(f[0])) samples.emplace_back(std::fabs(f[0]), gn);
+            }
+    if (samples.empty()) return 1.0f;
+    std::sort(samples.begin(), samples.end());
+    float l = 0.0f;
+    for (size_t i = 0; i < (samples.size() + 9) / 10; ++i) l = std::max(l, samples[i].second);
+    return l > 1e-6f ? 1.5f * l : 1.0f;
+}
+
+struct Parts {
+    std::string name;       // script file name
+    std::string code;       // everything but the entry point (no #version, no uniforms)
+    bool uses_time = false;
+};
+
+Parts generate(const Scene& scene) {
+    Graph& g = *scene.graph;
+    const Loc saved = g.loc();
+    g.set_loc(Loc{});  // nodes made outside any shape (the scene's final scaling) name no line
+    LoweredScene ls = lower_scene(g, scene);
+    Program dist = codegen(g, {ls.distance}, {"d"});
+    std::vector<NodeId> mroots(ls.material.begin(), ls.material.end());
+    Program mat = codegen(g, mroots, {"r", "g", "b", "specular", "shininess", "reflect", "transparency", "ior", "emit_r", "emit_g", "emit_b"});
+
+    // Settings as one more program (constants unless they depend on time).
+    auto node = [&](NodeId n, float dflt) { return n == kNoNode ? g.constant(dflt) : n; };
+    const CameraSettings& cam = scene.camera;
+    std::vector<NodeId> sroots;
+    auto push3 = [&](const Vec3N& v, glm::vec3 d) {
+        for (int i = 0; i < 3; ++i) sroots.push_back(node(v[i], d[i]));
+    };
+    push3(cam.position, {0, 0, 5});
+    push3(cam.target, {0, 0, 0});
+    push3(cam.up, {0, 1, 0});
+    sroots.push_back(node(cam.fov, 45.0f));
+    sroots.push_back(node(cam.ortho_height, 2.0f));
+    push3(scene.ambient, glm::vec3(0.05f));
+    push3(scene.background, glm::vec3(0.0f));
+    for (const LightSettings& l : scene.lights) {
+        if (l.directional) push3(l.direction, {0, -1, 0});
+        else push3(l.position, {0, 0, 0});
+        push3(l.color, {1, 1, 1});
+        sroots.push_back(node(l.intensity, 1.0f));
+        sroots.push_back(node(l.radius, 0.0f));
+    }
+    Program set = codegen(g, sroots, {});
+    g.set_loc(saved);
+
+    const RenderSettings& rs = scene.render;
+    const bool raw = scene.raw_field && !dist.outputs.empty();
+    const bool cone = rs.aa == "cone" && !raw;
+    const int samples = cone ? 1 : std::clamp(rs.samples, 1, 4096);
+    const int max_steps = std::max(rs.max_steps, 1);
+    const int max_bounces = std::clamp(rs.max_bounces, 0, 64);
+    const float eps = std::isfinite(rs.epsilon) && rs.epsilon > 0 ? rs.epsilon : 1e-4f;
+    const float max_dist = std::isfinite(rs.max_distance) && rs.max_distance > 0 ? rs.max_distance : 100.0f;
+    const int nlights = scene.lights.empty() ? 2 : static_cast<int>(scene.lights.size());
+
+    // The tracer's culling box (compiler bounds of the shape, as runtime/cpu/tracer.cpp pads them).
+    Bounds b = shape_bounds(g, *scene.root);
+    bool clip = false;
+    glm::vec3 lo(0.0f), hi(0.0f);
+    float raw_inv_l = 1.0f, raw_max_step = 0.05f;
+    if (raw && !b.finite()) {
+        // No bounds and no distance: the cube around the camera's target whose half-size is
+        // the camera's distance to it (as the CPU renderer does; a .vm model's camera is constant).
+        const glm::vec3 pos = const3(g, cam.position, {0, 0, 5}), target = const3(g, cam.target, {0, 0, 0});
+        const float r = std::max(glm::length(pos - target), 1.0f);
+        lo = target - glm::vec3(r);
+        hi = target + glm::vec3(r);
+        clip = std::isfinite(r);
+    } else if (b.finite()) {
+        const glm::vec3 ext = b.hi - b.lo;
+        const float m = 1e-3f * std::max(std::max(ext.x, std::max(ext.y, ext.z)), 0.0f) + 1e-3f;
+        lo = b.lo - glm::vec3(m);
+        hi = b.hi + glm::vec3(m);
+        clip = lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z;
+    }
+    if (raw) {
+        raw_inv_l = 1.0f / estimate_lipschitz(dist, lo, hi);
+        raw_max_step = clip ? glm::length(hi - lo) / 48.0f : 0.05f * max_dist;
+    }
+
+    Parts out;
+    out.name = script_name(scene);
+    out.uses_time = dist.uses_time || mat.uses_time || set.uses_time;
+    std::string& c = out.code;
+    c += fmt::format(
+        "// ---- render settings (the script's render(...)) ----\n"
+        "const int SDF_MAX_STEPS = {};\n"
+        "const float SDF_MAX_DIST = {};\n"
+        "const float SDF_EPSILON = {};\n"
+        "const bool SDF_SHADOWS = {};\n"
+        "const bool SDF_AO = {};  // ambient occlusion\n"
+        "const int SDF_MAX_BOUNCES = {};\n"
+        "const bool SDF_CONE = {};  // cone-traced anti-aliasing (render(aa = \"cone\"))\n"
+        "const bool SDF_2D = {};  // a 2D model: the Prospero image\n"
+        "const bool SDF_ORTHO = {};  // orthographic camera\n",
+        max_steps, literal(max_dist), literal(eps), rs.shadows ? "true" : "false", rs.ao && !raw ? "true" : "false", max_bounces,
+        cone ? "true" : "false", scene.is_2d ? "true" : "false", cam.orthographic ? "true" : "false");
+    c += fmt::format("const int SDF_SAMPLES = {};  // samples per pixel\nconst vec2 SDF_OFFSETS[SDF_SAMPLES] = vec2[SDF_SAMPLES](", samples);
+    for (int i = 0; i < samples; ++i) {
+        const float sx = (static_cast<float>(i) + 0.5f) / static_cast<float>(samples);
+        float sy = radical_inverse2(static_cast<uint32_t>(i)) + 0.5f / static_cast<float>(samples);
+        if (sy >= 1.0f) sy -= 1.0f;
+        c += fmt::format("{}vec2({}, {})", i ? (i % 4 == 0 ? ",\n    " : ", ") : "", literal(sx), literal(sy));
+    }
+    c += ");\n";
+    c += fmt::format("const float SDF_SAMPLE_WEIGHT = {};\nconst float SDF_MIN_WEIGHT = {};\n",
+                     literal(1.0f / static_cast<float>(samples)), literal(1e-3f / static_cast<float>(samples)));
+    c += fmt::format("const bool SDF_CLIP = {};  // rays are clipped to the scene's bounding box\n", clip ? "true" : "false");
+    c += fmt::format("const vec3 SDF_LO = {};\nconst vec3 SDF_HI = {};\n", vec3_lit(lo.x, lo.y, lo.z), vec3_lit(hi.x, hi.y, hi.z));
+    c += "const float SDF_RELAX = 1.5;  // over-relaxed sphere tracing\n";
+    c += fmt::format("const bool SDF_RAW = {};  // a raw field (.vm model): no distance bound, sign-change marching\n"
+                     "const float SDF_RAW_INV_LIPSCHITZ = {};\nconst float SDF_RAW_MAX_STEP = {};\n",
+                     raw ? "true" : "false", literal(raw_inv_l), literal(raw_max_step));
+    c += fmt::format("const int SDF_NUM_LIGHTS = {};\nconst bool SDF_DEFAULT_LIGHTS = {};  // the script has no light: the default rig\n\n",
+                     nlights, scene.lights.empty() ? "true" : "false");
+    c += glsl::kRendererHead;
+    if (glsl::uses_op(dist, Op::Noise3) || glsl::uses_op(mat, Op::Noise3) || glsl::uses_op(set, Op::Noise3)) {
+        c += "\n// Gradient noise, bit for bit the CPU's (compiler/ir/op_math.hpp).\n";
+        c += om::kGlslNoise;
+    }
+
+    glsl::FunctionSpec fs;
+    if (scene.root->kind == ShapeKind::Union) fs.quiet = scene.root->loc;
+    fs.signature = "float map(vec3 p)";
+    fs.var_prefix = "d";
+    c += "\n// ---- the scene's distance (a safe bound: 1-Lipschitz) ----\n";
+    c += glsl::function(dist, fs);
+
+    fs.signature = "Material sdf_material(vec3 p)";
+    fs.var_prefix = "m";
+    fs.finish = [](const std::vector<std::string>& o) {
+        // Channels that are not a plain name or number get a named local, for readability.
+        static const char* names[kMatChannels] = {"red", "green", "blue", "specular", "shininess", "reflectance", "transparency",
+                                                  "ior", "emit_red", "emit_green", "emit_blue"};
+        std::vector<std::string> lines, v(o.begin(), o.end());
+        for (int i = 0; i < kMatChannels; ++i)
+            if (v[i].find_first_of(" (") != std::string::npos) {
+                lines.push_back(fmt::format("float {} = {};", names[i], v[i]));
+                v[i] = names[i];
+            }
+        lines.push_back(fmt::format("return Material(vec3({}, {}, {}), {}, {}, {}, {}, {}, vec3({}, {}, {}));", v[0], v[1], v[2], v[3], v[4],
+                                    v[5], v[6], v[7], v[8], v[9], v[10]));
+        return lines;
+    };
+    c += "\n// ---- materials: colour, specular, shininess, reflectance, transparency, ior, emission ----\n";
+    c += glsl::function(mat, fs);
+
+    fs.signature = "void sdf_settings()";
+    fs.var_prefix = "s";
+    const std::vector<LightSettings>& lights = scene.lights;
+    fs.finish = [&lights](const std::vector<std::string>& o) {
+        std::vector<std::string> l;
+        auto v3 = [&](size_t i) { return fmt::format("vec3({}, {}, {})", o[i], o[i + 1], o[i + 2]); };
+        l.push_back("sdf_cam_position = " + v3(0) + ";");
+        l.push_back("sdf_cam_target = " + v3(3) + ";");
+        l.push_back("sdf_cam_up = " + v3(6) + ";");
+        l.push_back("sdf_cam_fov = " + o[9] + ";  // vertical, degrees");
+        l.push_back("sdf_cam_ortho_height = " + o[10] + ";");
+        l.push_back("sdf_ambient = " + v3(11) + ";");
+        l.push_back("sdf_background = " + v3(14) + ";");
+        if (lights.empty()) {
+            // The default rig of compiler/bytecode/compile.cpp: a key light over the camera's shoulder
+            // and a dim fill from the other side, both directional.
+            l.push_back("vec3 fwd = normalize(sdf_cam_target - sdf_cam_position);");
+            l.push_back("vec3 right = normalize(cross(fwd, sdf_cam_up));");
+            l.push_back("vec3 up = normalize(sdf_cam_up);");
+            l.push_back("sdf_lights[0] = SdfLight(true, vec3(0.0), normalize(fwd + 0.6 * right - 1.2 * up), vec3(1.0, 0.97, 0.92), 1.0, 0.0);");
+            l.push_back("sdf_lights[1] = SdfLight(true, vec3(0.0), normalize(fwd - 0.8 * right - 0.3 * up), vec3(0.55, 0.6, 0.7), 0.35, 0.0);");
+        }
+        for (size_t i = 0; i < lights.size(); ++i) {
+            const size_t b = 17 + 8 * i;
+            const std::string ln = lights[i].loc.known() ? fmt::format("  // line {}", lights[i].loc.line) : "";
+            if (lights[i].directional)
+                l.push_back(fmt::format("sdf_lights[{}] = SdfLight(true, vec3(0.0), {}, {}, {}, {});{}", i, v3(b), v3(b + 3), o[b + 6], o[b + 7], ln));
+            else
+                l.push_back(fmt::format("sdf_lights[{}] = SdfLight(false, {}, vec3(0.0, -1.0, 0.0), {}, {}, {});{}", i, v3(b), v3(b + 3), o[b + 6],
+                                        o[b + 7], ln));
+        }
+        return l;
+    };
+    c += "\n// ---- scene settings: camera, lights, ambient, background ----\n";
+    c += glsl::function(set, fs);
+    c += glsl::kRendererBody;
+    return out;
+}
+
+std::string header(const Parts& p, const char* target_line) {
+    return fmt::format("// Generated by sdfc from {}.\n{}", p.name, target_line);
+}
+
+}  // namespace
+
+std::string emit_glsl(const Scene& scene, GlslTarget target) {
+    if (!scene.graph || !scene.root) throw CompileError(Loc{}, "internal: the scene has no graph");
+    Parts p = generate(scene);
+    switch (target) {
+        case GlslTarget::Shadertoy: {
+            std::string s = header(p,
+                                   "// Shadertoy: paste into a new shader's Image tab on shadertoy.com. The script's `time` is\n"
+                                   "// iTime; drag with the mouse to orbit the camera around its target (release: the\n"
+                                   "// script's camera). The picture matches `sdfc render` (same camera, tracing and shading).\n\n");
+            s += p.code;
+            s += "\nvoid mainImage(out vec4 fragColor, in vec2 fragCoord) {\n"
+                 "    fragColor = sdf_render(fragCoord, iResolution.xy, iTime, sdf_mouse_orbit(iMouse, iResolution.xy), vec2(0.0));\n"
+                 "}\n";
+            return s;
+        }
+        case GlslTarget::Glsl330: {
+            std::string s = "#version 330 core\n";
+            s += header(p,
+                        "// A desktop OpenGL 3.3 fragment shader. Draw a full-screen triangle (any vertex shader\n"
+                        "// that covers the viewport) and set these uniforms:\n"
+                        "//   iResolution  viewport size in pixels\n"
+                        "//   iTime        scene time in seconds (the script's `time`)\n"
+                        "//   iMouse       Shadertoy's convention: xy = pointer position in pixels (origin at\n"
+                        "//                the bottom left), zw = where the button went down, z > 0 while pressed;\n"
+                        "//                while pressed, dragging orbits the camera; all zero: the script's camera.\n"
+                        "// fragColor is display-ready (sRGB-encoded) colour; write it to an 8-bit framebuffer\n"
+                        "// without GL_FRAMEBUFFER_SRGB.\n\n");
+            // Shadertoy's names (LANGUAGE.md: `time` becomes iTime in GLSL).
+            s += "uniform vec2 iResolution;\nuniform float iTime;\nuniform vec4 iMouse;\nout vec4 fragColor;\n\n";
+            s += p.code;
+            s += "\nvoid main() {\n"
+                 "    fragColor = sdf_render(gl_FragCoord.xy, iResolution, iTime, sdf_mouse_orbit(iMouse, iResolution), vec2(0.0));\n"
+                 "}\n";
+            return s;
+        }
+        case GlslTarget::Html: {
+            std::string s = "#version 300 es\n";
+            s += header(p, "// WebGL2 preview shader (GLSL ES 3.00): the Shadertoy code plus uniforms for the page's camera.\n\n");
+            s += "precision highp float;\nprecision highp int;\n"
+                 "uniform vec3 iResolution;\nuniform float iTime;\nuniform vec4 iMouse;\n"
+                 "uniform vec4 uOrbit;  // yaw, pitch (radians), zoom, on\n"
+                 "uniform vec2 uPan;    // target offset in the view plane, in units of the orbit radius\n"
+                 "out vec4 sdf_frag_color;\n\n";
+            s += p.code;
+            s += "\nvoid mainImage(out vec4 fragColor, in vec2 fragCoord) {\n"
+                 "    fragColor = sdf_render(fragCoord, iResolution.xy, iTime, sdf_mouse_orbit(iMouse, iResolution.xy), vec2(0.0));\n"
+                 "}\n\n"
+                 "void main() {\n"
+                 "    sdf_frag_color = sdf_render(gl_FragCoord.xy, iResolution.xy, iTime, uOrbit, uPan);\n"
+                 "}\n";
+            return glsl::html_page(p.name, s, p.uses_time);
+        }
+    }
+    return {};
+}
+
+}  // namespace sdfc

@@ -1,0 +1,20 @@
+// The GLSL backend: the scene's programs as GLSL, generated from the same IR and opcode
+// table as the VM, with the CPU renderer's camera, tracing and shading.
+#pragma once
+#include <string>
+
+#include "compiler/scene/scene.hpp"
+
+namespace sdfc {
+
+enum class GlslTarget {
+    Shadertoy,  // mainImage(out vec4, in vec2); iResolution, iTime, iMouse; pastes into shadertoy.com
+    Glsl330,    // desktop `#version 330 core` fragment shader with main() and documented uniforms
+    Html,       // one self-contained WebGL2 page with an orbit camera and a time slider
+};
+
+// `scene` must be built with a symbolic time (InterpretOptions::time = nullopt) so `time`
+// becomes iTime. Throws CompileError for settings GLSL cannot express.
+std::string emit_glsl(const Scene& scene, GlslTarget target);
+
+}  // namespace sdfc

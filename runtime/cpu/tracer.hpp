@@ -1,0 +1,76 @@
+// The CPU renderer: sphere tracing of a CompiledScene into a linear-light Image.
+//
+// Work is split into square tiles (oneTBB parallel_for); each worker thread owns one batch
+// Evaluator per program, built once. Within a tile every stage is batched: all rays of the
+// tile are marched together through a 64-lane window that is refilled as rays finish, then
+// normals (tetrahedron, 4 evals per hit), materials, shadow rays, AO taps and secondary
+// rays are evaluated in batches too. A tile's result depends only on the tile, so the
+// image is bit-identical for any thread count. See tracer.cpp for the shading model.
+//
+// Acceleration (all off with RenderOptions::baseline): before the tiles, a "tape tree" is
+// built once per frame: an octree over the scene whose cells carry the distance program
+// shortened for that cell (interval arithmetic + tape simplification, runtime/eval/interval.hpp).
+// Every distance evaluation (camera, shadow, secondary rays, normals, AO) runs the tape of
+// the leaf cell containing its point, and rays jump over cells the interval proves empty.
+// Plus over-relaxed sphere tracing and clipping to the scene's bounding box.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "compiler/bytecode/compile.hpp"
+#include "runtime/io/image.hpp"
+
+namespace sdfc {
+
+enum class RenderView {
+    Shaded,  // the picture
+    Steps,   // heat map of the primary rays' sphere-tracing step counts (`--view steps`)
+};
+
+// Progress of one render(): tiles finished out of all tiles, and the wall time since the
+// render began (tape-tree build included).
+struct RenderProgress {
+    int tiles_done = 0, tiles_total = 0;
+    double elapsed_s = 0.0;
+};
+
+struct RenderOptions {
+    int threads = 0;                // 0 = all hardware threads
+    std::vector<std::string> aovs;  // any of "depth", "normal", "steps" (see AovPlane)
+    RenderView view = RenderView::Shaded;
+    // Plain Hart sphere tracing on the full program: no tape tree (pruning, empty-space
+    // skipping), no over-relaxation, no bounding-box clipping (`--baseline`, for measuring).
+    bool baseline = false;
+    // Called about every 0.1 s while tiles finish, from whichever render thread finished
+    // one (never two calls at once), and once at the end with tiles_done == tiles_total
+    // from the calling thread. Must not throw.
+    std::function<void(const RenderProgress&)> progress;
+};
+
+struct RenderStats {
+    uint64_t distance_points = 0;  // points evaluated by the distance program
+    // ... of which: camera and secondary rays, normals, shadow rays, ambient-occlusion taps
+    enum Kind { kRays, kNormals, kShadows, kAo, kKinds };
+    uint64_t distance_points_by[kKinds] = {0, 0, 0, 0};
+    uint64_t shading_points = 0;   // points evaluated by the shading (material) program
+    uint64_t primary_rays = 0;
+    // Cost detail (the tracer only): instructions run by the distance and shading
+    // evaluations (tape length x points), cells rays jumped over without an evaluation, and
+    // the tape tree (leaves, interval boxes evaluated to build it, build wall time).
+    uint64_t distance_instructions = 0;
+    uint64_t shading_instructions = 0;
+    uint64_t skips = 0;
+    uint64_t tree_leaves = 0, interval_boxes = 0;
+    double tree_ms = 0.0;
+};
+
+// The names render() accepts in RenderOptions::aovs.
+const std::vector<std::string>& known_aovs();
+
+// Renders scene.render.width x scene.render.height pixels. Throws std::invalid_argument for
+// an unknown AOV name. `stats`, when given, receives the evaluation counts.
+Image render(const CompiledScene& scene, const RenderOptions& options, RenderStats* stats = nullptr);
+
+}  // namespace sdfc
