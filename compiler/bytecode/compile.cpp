@@ -46,6 +46,21 @@ void check_constants(const Program& p) {
 
 }  // namespace
 
+SceneBounds scene_bounds(const Scene& scene) {
+    const Graph& g = *scene.graph;
+    SceneBounds out;
+    out.bounds = shape_bounds(g, *scene.root);
+    if (!out.bounds.finite() && !scene.raw_field) {
+        Bounds box{glm::vec3(1e30f), glm::vec3(-1e30f)};
+        std::vector<glm::vec4> half_spaces;
+        if (clip_regions(g, *scene.root, box, half_spaces) && !half_spaces.empty()) {
+            out.solid_bounds = box;
+            out.half_spaces = std::move(half_spaces);
+        }
+    }
+    return out;
+}
+
 CompiledScene compile_scene(const Scene& scene) {
     Graph& g = *scene.graph;
     CompiledScene cs;
@@ -104,15 +119,10 @@ CompiledScene compile_scene(const Scene& scene) {
     cs.ambient = constant3(g, scene.ambient, c.loc, "the ambient color");
     cs.background = constant3(g, scene.background, c.loc, "the background color");
     cs.render = scene.render;
-    cs.bounds = shape_bounds(g, *scene.root);
-    if (!cs.bounds.finite() && !scene.raw_field) {
-        Bounds box{glm::vec3(1e30f), glm::vec3(-1e30f)};
-        std::vector<glm::vec4> half_spaces;
-        if (clip_regions(g, *scene.root, box, half_spaces) && !half_spaces.empty()) {
-            cs.solid_bounds = box;
-            cs.half_spaces = std::move(half_spaces);
-        }
-    }
+    SceneBounds sb = scene_bounds(scene);
+    cs.bounds = sb.bounds;
+    cs.solid_bounds = sb.solid_bounds;
+    cs.half_spaces = std::move(sb.half_spaces);
     cs.is_2d = scene.is_2d;
     cs.raw_field = scene.raw_field;
     cs.time = scene.time;

@@ -27,6 +27,16 @@ struct ResolvedLight {
     float radius = 0.0f;
 };
 
+// Where the scene's surfaces can be (compiler/scene/lower.hpp shape_bounds, clip_regions):
+// `bounds`; when that is infinite because of floor planes, every surface lies in
+// solid_bounds (possibly empty) or in one of the half-spaces n.p <= w (unit n).
+struct SceneBounds {
+    Bounds bounds;
+    Bounds solid_bounds;
+    std::vector<glm::vec4> half_spaces;
+};
+SceneBounds scene_bounds(const Scene& scene);
+
 struct CompiledScene {
     Program distance;  // outputs: "d", a 1-Lipschitz bound of the distance
     Program shading;   // outputs: "d", then the kMatChannels material channels
