@@ -17,10 +17,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include <fmt/format.h>
 
 #include "compiler/bytecode/compile.hpp"
+#include "compiler/render/plan.hpp"
 #include "compiler/glsl/glsl_emit.hpp"
 #include "compiler/glsl/glsl_html.hpp"
 #include "compiler/glsl/glsl_renderer.hpp"
@@ -33,15 +35,6 @@ using glsl::literal;
 
 std::string vec3_lit(float x, float y, float z) {
     return fmt::format("vec3({}, {}, {})", literal(x), literal(y), literal(z));
-}
-
-float radical_inverse2(uint32_t i) {  // as runtime/cpu/tracer.cpp
-    i = (i << 16) | (i >> 16);
-    i = ((i & 0x55555555u) << 1) | ((i & 0xAAAAAAAAu) >> 1);
-    i = ((i & 0x33333333u) << 2) | ((i & 0xCCCCCCCCu) >> 2);
-    i = ((i & 0x0F0F0F0Fu) << 4) | ((i & 0xF0F0F0F0u) >> 4);
-    i = ((i & 0x00FF00FFu) << 8) | ((i & 0xFF00FF00u) >> 8);
-    return static_cast<float>(i) * 2.3283064365386963e-10f;
 }
 
 // The script's name, for the header comment.
@@ -58,34 +51,6 @@ glm::vec3 const3(const Graph& g, const Vec3N& v, glm::vec3 dflt) {
     for (int i = 0; i < 3; ++i)
         if (v[i] != kNoNode && g.is_const(v[i])) r[i] = g.const_value(v[i]);
     return r;
-}
-
-// A Lipschitz estimate for a raw field over a box, as runtime/cpu/tracer.cpp makes it: the largest
-// gradient norm (forward differences) on a 16^3 grid among the tenth of the points with the
-// smallest |f|, times 1.5.
-float estimate_lipschitz(const Program& prog, const glm::vec3& lo, const glm::vec3& hi) {
-    constexpr int kGrid = 16;
-    const glm::vec3 ext = hi - lo;
-    const float m = std::max(ext.x, std::max(ext.y, ext.z));
-    if (!std::isfinite(m)) return 1.0f;
-    const float e = 1e-3f * std::max(m, 1e-6f);
-    std::vector<std::pair<float, float>> samples;  // (|f|, |grad f|)
-    for (int k = 0; k < kGrid; ++k)
-        for (int j = 0; j < kGrid; ++j)
-            for (int i = 0; i < kGrid; ++i) {
-                const glm::vec3 p = lo + ext * (glm::vec3(i, j, k) + 0.5f) / static_cast<float>(kGrid);
-                float f[4];
-                for (int q = 0; q < 4; ++q)
-                    f[q] = eval_scalar(prog, p.x + (q == 1 ? e : 0.0f), p.y + (q == 2 ? e : 0.0f), p.z + (q == 3 ? e : 0.0f), 0.0f)[0];
-                const glm::vec3 gr(f[1] - f[0], f[2] - f[0], f[3] - f[0]);
-                const float gn = glm::length(gr) / e;
-                if (std::isfinite(gn) && std::isfinite(f[0])) samples.emplace_back(std::fabs(f[0]), gn);
-            }
-    if (samples.empty()) return 1.0f;
-    std::sort(samples.begin(), samples.end());
-    float l = 0.0f;
-    for (size_t i = 0; i < (samples.size() + 9) / 10; ++i) l = std::max(l, samples[i].second);
-    return l > 1e-6f ? 1.5f * l : 1.0f;
 }
 
 struct Parts {
@@ -127,40 +92,27 @@ Parts generate(const Scene& scene) {
     Program set = codegen(g, sroots, {});
     g.set_loc(saved);
 
+    // The settings, resolved as for the CPU (compiler/render/plan.cpp): only what is
+    // constant is known here (the camera may depend on time).
+    PlanInputs in;
+    in.settings = scene.render;
+    in.bounds = scene_bounds(scene);
+    in.is_2d = scene.is_2d;
+    in.raw_field = scene.raw_field;
+    in.has_distance = !dist.outputs.empty();
+    auto const_point = [&](const Vec3N& v) -> std::optional<glm::vec3> {
+        for (NodeId n : v)
+            if (n != kNoNode && !g.is_const(n)) return std::nullopt;
+        return const3(g, v, {0, 0, 0});
+    };
+    in.camera_position = cam.position[0] == kNoNode ? std::optional<glm::vec3>(glm::vec3(0, 0, 5)) : const_point(cam.position);
+    in.camera_target = cam.target[0] == kNoNode ? std::optional<glm::vec3>(glm::vec3(0)) : const_point(cam.target);
+    in.field = [&dist](const float* x, const float* y, const float* z, size_t n, float* out) {
+        for (size_t i = 0; i < n; ++i) out[i] = eval_scalar(dist, x[i], y[i], z[i], 0.0f)[0];
+    };
+    const RenderPlan plan = resolve_plan(in);
     const RenderSettings& rs = scene.render;
-    const bool raw = scene.raw_field && !dist.outputs.empty();
-    const bool cone = rs.aa == "cone" && !raw;
-    const int samples = cone ? 1 : std::clamp(rs.samples, 1, 4096);
-    const int max_steps = std::max(rs.max_steps, 1);
-    const int max_bounces = std::clamp(rs.max_bounces, 0, 64);
-    const float eps = std::isfinite(rs.epsilon) && rs.epsilon > 0 ? rs.epsilon : 1e-4f;
-    const float max_dist = std::isfinite(rs.max_distance) && rs.max_distance > 0 ? rs.max_distance : 100.0f;
     const int nlights = scene.lights.empty() ? 2 : static_cast<int>(scene.lights.size());
-
-    // The tracer's culling box (compiler bounds of the shape, as runtime/cpu/tracer.cpp pads them).
-    Bounds b = shape_bounds(g, *scene.root);
-    bool clip = false;
-    glm::vec3 lo(0.0f), hi(0.0f);
-    float raw_inv_l = 1.0f, raw_max_step = 0.05f;
-    if (raw && !b.finite()) {
-        // No bounds and no distance: the cube around the camera's target whose half-size is
-        // the camera's distance to it (as the CPU renderer does; a .vm model's camera is constant).
-        const glm::vec3 pos = const3(g, cam.position, {0, 0, 5}), target = const3(g, cam.target, {0, 0, 0});
-        const float r = std::max(glm::length(pos - target), 1.0f);
-        lo = target - glm::vec3(r);
-        hi = target + glm::vec3(r);
-        clip = std::isfinite(r);
-    } else if (b.finite()) {
-        const glm::vec3 ext = b.hi - b.lo;
-        const float m = 1e-3f * std::max(std::max(ext.x, std::max(ext.y, ext.z)), 0.0f) + 1e-3f;
-        lo = b.lo - glm::vec3(m);
-        hi = b.hi + glm::vec3(m);
-        clip = lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z;
-    }
-    if (raw) {
-        raw_inv_l = 1.0f / estimate_lipschitz(dist, lo, hi);
-        raw_max_step = clip ? glm::length(hi - lo) / 48.0f : 0.05f * max_dist;
-    }
 
     Parts out;
     out.name = script_name(scene);
@@ -177,24 +129,34 @@ Parts generate(const Scene& scene) {
         "const bool SDF_CONE = {};  // cone-traced anti-aliasing (render(aa = \"cone\"))\n"
         "const bool SDF_2D = {};  // a 2D model: the Prospero image\n"
         "const bool SDF_ORTHO = {};  // orthographic camera\n",
-        max_steps, literal(max_dist), literal(eps), rs.shadows ? "true" : "false", rs.ao && !raw ? "true" : "false", max_bounces,
-        cone ? "true" : "false", scene.is_2d ? "true" : "false", cam.orthographic ? "true" : "false");
-    c += fmt::format("const int SDF_SAMPLES = {};  // samples per pixel\nconst vec2 SDF_OFFSETS[SDF_SAMPLES] = vec2[SDF_SAMPLES](", samples);
-    for (int i = 0; i < samples; ++i) {
-        const float sx = (static_cast<float>(i) + 0.5f) / static_cast<float>(samples);
-        float sy = radical_inverse2(static_cast<uint32_t>(i)) + 0.5f / static_cast<float>(samples);
-        if (sy >= 1.0f) sy -= 1.0f;
-        c += fmt::format("{}vec2({}, {})", i ? (i % 4 == 0 ? ",\n    " : ", ") : "", literal(sx), literal(sy));
-    }
+        plan.max_steps, literal(plan.max_dist), literal(plan.eps), plan.shadows ? "true" : "false", plan.ao ? "true" : "false",
+        plan.max_bounces, plan.cone ? "true" : "false", plan.is_2d ? "true" : "false", cam.orthographic ? "true" : "false");
+    c += fmt::format("const int SDF_SAMPLES = {};  // samples per pixel\nconst vec2 SDF_OFFSETS[SDF_SAMPLES] = vec2[SDF_SAMPLES](", plan.samples);
+    for (int i = 0; i < plan.samples; ++i)
+        c += fmt::format("{}vec2({}, {})", i ? (i % 4 == 0 ? ",\n    " : ", ") : "", literal(plan.offsets[i].x), literal(plan.offsets[i].y));
     c += ");\n";
     c += fmt::format("const float SDF_SAMPLE_WEIGHT = {};\nconst float SDF_MIN_WEIGHT = {};\n",
-                     literal(1.0f / static_cast<float>(samples)), literal(1e-3f / static_cast<float>(samples)));
-    c += fmt::format("const bool SDF_CLIP = {};  // rays are clipped to the scene's bounding box\n", clip ? "true" : "false");
-    c += fmt::format("const vec3 SDF_LO = {};\nconst vec3 SDF_HI = {};\n", vec3_lit(lo.x, lo.y, lo.z), vec3_lit(hi.x, hi.y, hi.z));
-    c += "const float SDF_RELAX = 1.5;  // over-relaxed sphere tracing\n";
+                     literal(1.0f / static_cast<float>(plan.samples)), literal(plan.min_weight));
+    c += fmt::format("const bool SDF_CLIP = {};  // rays are clipped to the scene's bounding box\n", plan.clip ? "true" : "false");
+    c += fmt::format("const vec3 SDF_LO = {};\nconst vec3 SDF_HI = {};\n", vec3_lit(plan.lo.x, plan.lo.y, plan.lo.z),
+                     vec3_lit(plan.hi.x, plan.hi.y, plan.hi.z));
+    // Floor planes: rays are clipped to the hull of their parts under a plane or in the box
+    // of everything else (as on the CPU).
+    const size_t nplanes = plan.planes.size();
+    c += fmt::format("const int SDF_NUM_PLANES = {};  // floor planes n.p <= w clipping rays, with the box below\n", nplanes);
+    c += fmt::format("const vec4 SDF_PLANES[{}] = vec4[{}](", std::max<size_t>(nplanes, 1), std::max<size_t>(nplanes, 1));
+    for (size_t i = 0; i < nplanes; ++i) {
+        const glm::vec4& q = plan.planes[i];
+        c += fmt::format("{}vec4({}, {}, {}, {})", i ? ", " : "", literal(q.x), literal(q.y), literal(q.z), literal(q.w));
+    }
+    if (nplanes == 0) c += "vec4(0.0)";
+    c += ");\n";
+    c += fmt::format("const vec3 SDF_SOLID_LO = {};\nconst vec3 SDF_SOLID_HI = {};\n", vec3_lit(plan.solid_lo.x, plan.solid_lo.y, plan.solid_lo.z),
+                     vec3_lit(plan.solid_hi.x, plan.solid_hi.y, plan.solid_hi.z));
+    c += fmt::format("const float SDF_RELAX = {};  // over-relaxed sphere tracing\n", literal(plan.relax));
     c += fmt::format("const bool SDF_RAW = {};  // a raw field (.vm model): no distance bound, sign-change marching\n"
                      "const float SDF_RAW_INV_LIPSCHITZ = {};\nconst float SDF_RAW_MAX_STEP = {};\n",
-                     raw ? "true" : "false", literal(raw_inv_l), literal(raw_max_step));
+                     plan.raw ? "true" : "false", literal(1.0f / plan.raw_lipschitz), literal(plan.raw_max_step));
     c += fmt::format("const int SDF_NUM_LIGHTS = {};\nconst bool SDF_DEFAULT_LIGHTS = {};  // the script has no light: the default rig\n\n",
                      nlights, scene.lights.empty() ? "true" : "false");
     c += glsl::kRendererHead;
@@ -243,8 +205,7 @@ Parts generate(const Scene& scene) {
         l.push_back("sdf_ambient = " + v3(11) + ";");
         l.push_back("sdf_background = " + v3(14) + ";");
         if (lights.empty()) {
-            // The default rig of compiler/bytecode/compile.cpp: a key light over the camera's shoulder
-            // and a dim fill from the other side, both directional.
+            // The default rig (compiler/render/rules.h, as compiler/render/plan.cpp makes it).
             l.push_back("vec3 fwd = normalize(sdf_cam_target - sdf_cam_position);");
             l.push_back("vec3 right = normalize(cross(fwd, sdf_cam_up));");
             l.push_back("vec3 up = normalize(sdf_cam_up);");
