@@ -1,12 +1,10 @@
-// Interval arithmetic (runtime/eval/interval.hpp): every opcode's interval encloses what the
-// batch VM computes at every point of the box, bit for bit, and a decided choice is the
-// VM's choice at every point; simplified tapes compute the same floats as their parent
-// inside the box.
+// Tape simplification (runtime/eval/interval.hpp) on a scene of several shapes: simplified
+// tapes, and tapes simplified again from them, compute the same floats as their parent
+// inside the box. (Every opcode, shape and example through the interval evaluators and the
+// simplifiers: tests/conformance/test_boxes.cpp.)
 #include <catch2/catch.hpp>
 
 #include <cmath>
-#include <cstdlib>
-#include <limits>
 #include <random>
 
 #include "compiler/bytecode/compile.hpp"
@@ -19,7 +17,6 @@ using namespace sdfc;
 
 namespace {
 
-
 bool unknown(Interval r) { return std::isnan(r.lo) || std::isnan(r.hi); }
 
 bool inside(float v, Interval r) {
@@ -28,86 +25,7 @@ bool inside(float v, Interval r) {
     return r.lo <= v && v <= r.hi;
 }
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-
 }  // namespace
-
-TEST_CASE("every opcode: the interval encloses the VM's value at every point of the box") {
-    std::mt19937 rng(std::getenv("SDFC_TEST_SEED") ? uint32_t(std::atoi(std::getenv("SDFC_TEST_SEED"))) : 12345u);
-    const float specials[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, -2.5f, 3.0f, 1e-3f, -1e-3f, 7.25f, -100.0f, 1e30f, -1e30f,
-                              1.5707964f, 3.1415927f, -3.1415927f, 6.2831855f, 1e-38f};
-    std::uniform_real_distribution<float> u(-4.0f, 4.0f);
-    std::uniform_int_distribution<int> pick(0, int(std::size(specials)) - 1);
-    auto endpoint = [&]() { return (rng() % 3 == 0) ? specials[pick(rng)] : u(rng) * ((rng() % 4 == 0) ? 10.0f : 1.0f); };
-    // Boxes: mostly finite, some with infinite ends, some unknown ([NaN, NaN]: any value).
-    auto box = [&]() {
-        const int kind = int(rng() % 16);
-        if (kind == 0) return Interval{kNaN, kNaN};
-        float a = endpoint(), b = (rng() % 5 == 0) ? a : endpoint();
-        Interval r{std::min(a, b), std::max(a, b)};
-        if (kind == 1) r.lo = -kInf;
-        if (kind == 2) r.hi = kInf;
-        if (kind == 3) r = Interval{-kInf, kInf};
-        return r;
-    };
-    for (int o = 0; o < kOpCount; ++o) {
-        const Op op = static_cast<Op>(o);
-        if (is_input(op)) continue;
-        for (int trial = 0; trial < 300; ++trial) {
-            const float k = (trial % 7 == 0) ? specials[pick(rng)] : u(rng);
-            Interval A = box(), B = box(), C = box();
-            if (op == Op::Select && trial % 3 == 0) A = Interval{0.0f, 0.0f};
-            uint8_t choice = 0;
-            const Interval r = eval_interval(op, A, B, C, k, &choice);
-            // Unknown is both ends NaN, never one.
-            INFO(op_info(op).mnemonic << " k=" << k << " a=[" << A.lo << "," << A.hi << "] b=[" << B.lo << "," << B.hi << "] c=[" << C.lo << "," << C.hi << "] -> [" << r.lo << "," << r.hi << "]");
-            REQUIRE(std::isnan(r.lo) == std::isnan(r.hi));
-            Program p = test::single_op_program(op, k);
-            Evaluator ev(p);
-            float xs[kBatch], ys[kBatch], zs[kBatch];
-            auto sample = [&](Interval I, int i) {
-                if (unknown(I)) {
-                    const float any[] = {kNaN, kInf, -kInf, 0.0f, 1e30f, -2.5f, 0.75f};
-                    return any[rng() % std::size(any)];
-                }
-                if (i == 0) return I.lo;
-                if (i == 1) return I.hi;
-                float lo = std::isinf(I.lo) ? std::max(-1e6f, std::min(I.hi, 0.0f) - 10.0f) : I.lo;
-                float hi = std::isinf(I.hi) ? std::min(1e6f, std::max(I.lo, 0.0f) + 10.0f) : I.hi;
-                float t = float(rng() % 1000) / 999.0f;
-                return std::clamp(lo + (hi - lo) * t, I.lo, I.hi);
-            };
-            for (int i = 0; i < kBatch; ++i) {
-                xs[i] = sample(A, i % 3 == 2 ? 2 : i % 2);
-                ys[i] = sample(B, (i / 2) % 3);
-                zs[i] = sample(C, (i / 6) % 3);
-            }
-            ev.eval(xs, ys, zs, kBatch, 0.0f);
-            for (int i = 0; i < kBatch; ++i) {
-                const float v = ev.output(0)[i];
-                INFO(op_info(op).mnemonic << " k=" << k << " a=[" << A.lo << "," << A.hi << "] b=[" << B.lo << "," << B.hi
-                                         << "] c=[" << C.lo << "," << C.hi << "] -> [" << r.lo << "," << r.hi
-                                         << "] point (" << xs[i] << "," << ys[i] << "," << zs[i] << ") = " << v);
-                REQUIRE(inside(v, r));
-                if (choice == kChoiceA) REQUIRE(std::bit_cast<uint32_t>(v) == std::bit_cast<uint32_t>(xs[i]));
-                if (choice == kChoiceB) {
-                    const float w = op_info(op).has_imm ? k : ys[i];
-                    REQUIRE(std::bit_cast<uint32_t>(v) == std::bit_cast<uint32_t>(w));
-                }
-                if (choice == kChoiceC) REQUIRE(std::bit_cast<uint32_t>(v) == std::bit_cast<uint32_t>(zs[i]));
-            }
-        }
-    }
-}
-
-TEST_CASE("is_choice_op: exactly the ops whose interval can pick a side") {
-    for (int o = 0; o < kOpCount; ++o) {
-        const Op op = static_cast<Op>(o);
-        const bool want = op == Op::Min || op == Op::Max || op == Op::MinI || op == Op::MaxI || op == Op::Select;
-        REQUIRE(is_choice_op(op) == want);
-    }
-}
 
 TEST_CASE("simplified tapes compute the same floats as the full tape inside their box") {
     auto c = test::compile_text(R"(

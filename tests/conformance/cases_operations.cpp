@@ -1,0 +1,149 @@
+// Every operation of LANGUAGE.md section 6: a known distance, a sign, or a reference formula
+// at random points. (Properties relating two evaluations, such as periodicity, stay in
+// tests/compiler/test_operations.cpp.)
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "conformance/cases.hpp"
+
+namespace sdfc::conformance {
+
+namespace {
+
+double sph(double x, double y, double z, double cx, double r) { return std::sqrt((x - cx) * (x - cx) + y * y + z * z) - r; }
+
+// The nearest of spheres of radius r at the given centres.
+ShapeCases::Ref spheres(std::vector<std::array<double, 3>> cs, double r) {
+    return [cs, r](double x, double y, double z) {
+        double best = 1e30;
+        for (auto& c : cs) best = std::min(best, std::sqrt((x - c[0]) * (x - c[0]) + (y - c[1]) * (y - c[1]) + (z - c[2]) * (z - c[2])) - r);
+        return best;
+    };
+}
+
+double stairs(double a, double b, double r, double n) {
+    double s = r / n, u = b - r;
+    double m = (u - a + s) - 2 * s * std::floor((u - a + s) / (2 * s));
+    return std::min(std::min(a, b), 0.5 * (u + a + std::fabs(m - s)));
+}
+
+}  // namespace
+
+void add_operation_cases(std::vector<Case>& out) {
+    ShapeCases s(out);
+
+    // union, intersection, difference, xor of two unit spheres 1.5 apart.
+    s.script("union { sphere(1); translate([1.5, 0, 0]) sphere(1); }")
+        .random([](double x, double y, double z) { return std::min(sph(x, y, z, 0, 1), sph(x, y, z, 1.5, 1)); }, 3, 200);
+    s.script("intersection { sphere(1); translate([1.5, 0, 0]) sphere(1); }")
+        .random([](double x, double y, double z) { return std::max(sph(x, y, z, 0, 1), sph(x, y, z, 1.5, 1)); }, 3, 200);
+    s.script("difference { sphere(1); translate([1.5, 0, 0]) sphere(1); }")
+        .random([](double x, double y, double z) { return std::max(sph(x, y, z, 0, 1), -sph(x, y, z, 1.5, 1)); }, 3, 200);
+    s.script("xor { sphere(1); translate([1.5, 0, 0]) sphere(1); }").random([](double x, double y, double z) {
+        const double a = sph(x, y, z, 0, 1), b = sph(x, y, z, 1.5, 1);
+        return std::max(std::min(a, b), -std::max(a, b));
+    }, 3, 200);
+    // Difference takes the first minus all the rest.
+    s.script("difference { box(4); sphere(1); translate([0, 0, 2]) sphere(1); }").greater(0, 0, 0, 0).greater(0, 0, 2, 0).less(1.5, 1.5, 0, 0);
+
+    // A for statement in a CSG block is one operand, the union of its iterations
+    // (LANGUAGE.md section 4; as in OpenSCAD).
+    s.script("difference {\n for (x = [-1, 1]) translate([x, 0, 0]) sphere(0.5);\n sphere(0.2);\n}").at(1, 0, 0, -0.5).at(-1, 0, 0, -0.5).at(0, 0, 0, 0.5);
+    s.script("intersection { for (x = [-1, 1]) translate([x * 0.5, 0, 0]) sphere(1); box(10); }").at(1.4f, 0, 0, -0.1f);
+    // Cut by a loop: the rest of a difference may be a loop too.
+    s.script("difference { box(4); for (z = [-1, 1]) translate([0, 0, z]) sphere(0.5); }").at(0, 0, 1, 0.5).less(0, 0, 0, 0);
+    // A lone loop is the first operand and nothing is subtracted.
+    s.script("difference { for (x = [-1, 1]) translate([x, 0, 0]) sphere(0.5); }").at(1, 0, 0, -0.5).at(-1, 0, 0, -0.5);
+    // Union-like blocks take the iterations as operands: a smooth union blends them.
+    s.script("union { for (x = [-1, 1]) translate([x, 0, 0]) sphere(0.8); sphere(0.1); }").at(0, 1, 0, std::sqrt(2.0f) - 0.8f);
+    s.script("smooth_union(1) { for (x = [-1, 1]) translate([x, 0, 0]) sphere(0.8); sphere(0.1); }").less(0, 1, 0, std::sqrt(2.0f) - 0.8f - 0.1f);
+
+    // Smooth operations equal the hard ones beyond k and blend within: where both distances
+    // are equal the quadratic smin lowers the union by k/4.
+    s.script("smooth_union(0.5) { sphere(1); translate([3, 0, 0]) sphere(1); }")
+        .at(-2, 0, 0, 1)
+        .at(1.5, 0, 0, 0.5 - 0.125)
+        .random_bound([](double x, double y, double z) { return std::min(sph(x, y, z, 0, 1), sph(x, y, z, 3, 1)); },
+                      [](double x, double y, double z) { return std::fabs(sph(x, y, z, 0, 1) - sph(x, y, z, 3, 1)) <= 0.5; }, 2e-6, 3, 300, 99);
+    s.script("smooth_intersection(0.5) { sphere(1); translate([1, 0, 0]) sphere(1); }").at(-1, 0, 0, 1).at(0.5, 0, 0, -0.5 + 0.125);
+    // Difference: b's inside carved out; at a == -b the blend raises by k/4.
+    s.script("smooth_difference(0.5) { sphere(1); translate([1, 0, 0]) sphere(1); }").at(0, 0, 0, 0).at(-0.5, 0, 0, -0.5 + 0.125);
+
+    // Chamfer and stairs follow hg_sdf (chamfer's diagonal halved: same surface, 1-Lipschitz).
+    // Two boxes meeting at a right angle (x < 0 and y < 0 solids): the chamfer cuts the corner.
+    s.script("chamfer_union(0.4) { translate([-5, 0, 0]) box([10, 10, 10]); translate([0, -5, 0]) box([10, 10, 10]); }")
+        .at(0.3f, 0.3f, 0, std::min(0.3, (0.3 + 0.3 - 0.4) * 0.5))
+        .at(3, 3, 0, (3 + 3 - 0.4) * 0.5);  // a bound there: below the true 3
+    s.script("chamfer_intersection(0.4) { box(2); translate([0.5, 0, 0]) box(2); }").at(0, 0, 0, std::max({-1.0, -0.5, (-1 - 0.5 + 0.4) * 0.5}));
+    s.script("chamfer_difference(0.4) { box(2); translate([2, 0, 0]) box(2); }").greater(0.95f, 0.95f, 0, -0.05f);
+    s.script("stairs_union(0.5, 3) { translate([-5, 0, 0]) box([10, 10, 10]); translate([0, -5, 0]) box([10, 10, 10]); }");
+    for (float t : {0.05f, 0.1f, 0.2f, 0.3f, 0.45f}) s.at(t, t * 0.7f, 0, stairs(t, t * 0.7f, 0.5, 3));
+    s.script("stairs_intersection(0.5, 3) { sphere(1); translate([1, 0, 0]) sphere(1); }")
+        .at(0.5, 0.3f, 0, -stairs(-(std::sqrt(0.25 + 0.09) - 1), -(std::sqrt(0.25 + 0.09) - 1), 0.5, 3));
+    s.script("stairs_difference(0.5, 3) { sphere(1); translate([1, 0, 0]) sphere(1); }").less(-0.9f, 0, 0, 0).greater(0.9f, 0, 0, 0);
+
+    // translate, rotate, scale, mirror. rotate(x=, y=, z=) in degrees, x first, then y, then z.
+    s.script("translate([1, 2, 3]) sphere(1);").at(1, 2, 3, -1);
+    s.script("rotate(x = 90) translate([0, 1, 0]) sphere(0.1);").at(0, 0, 1, -0.1);  // (0,1,0) turned about x goes to (0,0,1)
+    s.script("rotate(x = 90, z = 90) translate([0, 1, 0]) sphere(0.1);").at(0, 0, 1, -0.1);  // z leaves (0,0,1) in place
+    s.script("rotate(y = 90, z = 90) translate([1, 0, 0]) sphere(0.1);").at(0, 0, -1, -0.1);  // y: (1,0,0) -> (0,0,-1)
+    s.script("rotate(90, [0, 0, 1]) translate([1, 0, 0]) sphere(0.1);").at(0, 1, 0, -0.1);
+    s.script("rotate(angle = 180, axis = [1, 1, 0]) translate([1, 0, 0]) sphere(0.1);").at(0, 1, 0, -0.1);
+    // scale: uniform keeps the exact distance; a vector keeps a bound.
+    s.script("scale(2) sphere(1);").at(4, 0, 0, 2);
+    s.script("scale([2, 1, 1]) sphere(1);").at(2, 0, 0, 0).at(0, 1, 0, 0).less(4, 0, 0, 2.0f + 1e-5f).greater(4, 0, 0, 0);
+    // mirror is an involution and reflects through the plane with the given normal.
+    s.script("mirror([1, 0, 0]) translate([2, 0, 0]) sphere(1);").at(-2, 0, 0, -1);
+    s.script("mirror([1, 1, 0]) mirror([1, 1, 0]) translate([2, 0.5, 0]) sphere(0.3);").at(2, 0.5f, 0, -0.3);
+
+    // repeat: finite stops after count; a zero period leaves the axis.
+    s.script("repeat([3, 0, 3]) sphere(0.5);").at(0, 3, 0, 2.5);  // y is not repeated
+    s.script("repeat(2, 1) sphere(0.5);").at(2, 2, -2, -0.5).at(4, 0, 0, 1.5);  // index 1 present, index 2 absent
+    s.script("repeat([2, 0, 0], [2, 0, 0]) sphere(0.5);").at(-4, 0, 0, -0.5).at(6, 0, 0, 1.5).at(0, 2, 0, 1.5);
+
+    // A child that reaches out of its cell is whole: the copies of the neighbouring cells that
+    // reach into a cell are evaluated there too. Finite: copies at 0.9 + 2k for k = -2..2.
+    std::vector<std::array<double, 3>> fc;
+    for (int k = -2; k <= 2; ++k) fc.push_back({0.9 + 2.0 * k, 0, 0});
+    s.script("repeat([2, 0, 0], 2) translate([0.9, 0, 0]) sphere(0.5);", 6).at(1.3f, 0, 0, -0.1f).random(spheres(fc, 0.5), 6, 300, 1e-4, 99);
+    // Infinite, on two axes, a child across a corner of its cell.
+    s.script("repeat([2, 0, 2]) translate([0.8, 0, -0.8]) sphere(0.4);").at(1.15f, 0, -0.8f, -0.05f).at(0.8f, 0, -1.15f, -0.05f).at(2.8f, 0, 1.2f, -0.4f);
+    // Polar: a child off copy 0's sector (+z, with 3 sectors centred on +x) is still there.
+    std::vector<std::array<double, 3>> pc;
+    for (int k = 0; k < 3; ++k) {
+        const double a = M_PI / 2 + k * 2 * M_PI / 3;  // copies at angles atan2(z, x)
+        pc.push_back({2 * std::cos(a), 0, 2 * std::sin(a)});
+    }
+    s.script("polar_repeat(3) translate([0, 0, 2]) sphere(0.5);", 4).at(0, 0, 2, -0.5).random(spheres(pc, 0.5), 4, 300, 1e-4, 99);
+    s.script("polar_repeat(6) translate([2, 0, 0]) sphere(0.3);").at(2, 0, 0, -0.3);
+
+    // symmetry mirrors the positive side onto the negative; x folds unless y or z is named.
+    s.script("symmetry(x = true) translate([2, 0, 0]) sphere(0.5);").at(-2, 0, 0, -0.5).at(2, 0, 0, -0.5);
+    s.script("symmetry(y = true, z = true) translate([0, 1, 1]) sphere(0.5);").at(0, -1, -1, -0.5).at(0, 1, -1, -0.5);
+    s.script("symmetry() translate([2, 1, 0]) sphere(0.5);").at(-2, 1, 0, -0.5);
+    s.script("symmetry(y = true) translate([2, 1, 0]) sphere(0.5);").at(2, -1, 0, -0.5).at(-2, 1, 0, 3.5);
+
+    // elongate inserts a straight section of length v.
+    s.script("elongate([2, 0, 0]) sphere(1);").at(2, 0, 0, 0).at(0, 2, 0, 1).at(1, 1, 0, 0).at(3, 0, 0, 1);
+
+    // twist and bend at rate 0 are the identity (the box's own distance).
+    const auto box_ref = [](double x, double y, double z) {
+        const double qx = std::fabs(x) - 0.5, qy = std::fabs(y) - 1, qz = std::fabs(z) - 0.25;
+        const double ox = std::max(qx, 0.0), oy = std::max(qy, 0.0), oz = std::max(qz, 0.0);
+        return std::sqrt(ox * ox + oy * oy + oz * oz) + std::min(std::max(qx, std::max(qy, qz)), 0.0);
+    };
+    s.script("twist(0) box([1, 2, 0.5]);").random(box_ref, 2, 100, 1e-5, 99);
+    s.script("bend(0) box([1, 2, 0.5]);").random(box_ref, 2, 100, 1e-5, 98);
+    // At height y the cross-section is turned by rate * y degrees: at y = 1 the long axis has
+    // turned 90 degrees onto z.
+    s.script("twist(90) box([2, 4, 0.2]);").less(0.9f, 0, 0, 0).less(0, 1, 0.9f, 0).greater(0.9f, 1, 0, 0);
+
+    // round grows the shape, onion shells it; displace with amplitude 0 is the shape.
+    s.script("round(0.5) box(2);").at(2, 0, 0, 0.5).at(1.5, 1.5, 0, std::sqrt(0.5) - 0.5);
+    s.script("onion(0.1) sphere(1);").at(0, 0, 0, 0.9).at(1, 0, 0, -0.1);
+    s.script("onion(thickness = 0.2) sphere(1);").at(1.1f, 0, 0, -0.1);
+    s.script("displace(0, 3) sphere(1);").at(1.5, 0.2f, 0.1f, std::sqrt(1.5 * 1.5 + 0.04 + 0.01) - 1);
+}
+
+}  // namespace sdfc::conformance
