@@ -1,7 +1,7 @@
 // The grammar of .sdf scripts (LANGUAGE.md sections 2-7) as PEGTL 3 rules, and nothing
-// else: the actions that build the AST live in lang/parser.cpp, the error messages in
-// grammar/error_messages.hpp. Include this header only from those two files (and the
-// grammar's own test): PEGTL templates are heavy to compile.
+// else: the actions that build the AST live in lang/parse_actions.hpp (compiled only in
+// lang/parser.cpp), the error messages in grammar/error_messages.hpp. Include this header
+// only from those files (and the grammar's own test): PEGTL templates are heavy to compile.
 //
 // Conventions
 // - Every token rule consumes the whitespace and comments after it (`sp`), so each rule

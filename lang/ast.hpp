@@ -4,7 +4,7 @@
 // after parsing, so closures may keep raw pointers into the tree.
 //
 // Expr and Stmt nodes are allocated from a per-thread pool of same-size slots (a script is
-// mostly small nodes; see NodePool in lang/parser.cpp): new, delete and make_unique work as
+// mostly small nodes; see NodePool in lang/node_pool.cpp): new, delete and make_unique work as
 // usual, and a node may be deleted by any thread.
 #pragma once
 #include <cstddef>

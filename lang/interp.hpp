@@ -1,5 +1,6 @@
 // Internal to lang/: the interpreter's state, shared by interpreter.cpp (statements and
-// expressions) and builtins.cpp (the built-in shapes, operations, settings and math).
+// blocks), expressions.cpp (expressions, calls, operators) and builtins.cpp (the built-in
+// shapes, operations, settings and math).
 #pragma once
 #include <deque>
 #include <functional>
@@ -67,7 +68,7 @@ public:
 
     Scene run(const SourceFile& file);
 
-    // --- evaluation (interpreter.cpp)
+    // --- evaluation (statements and blocks: interpreter.cpp; the rest: expressions.cpp)
     Value eval(const ast::Expr& e, Env* env);
     Value eval_block(const ast::Block& b, Env* env, bool field_scope);
     void exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out);

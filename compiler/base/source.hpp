@@ -10,6 +10,9 @@
 #include <string_view>
 #include <vector>
 
+#include "compiler/base/names.hpp"  // nearest_name (did you mean), for the callers of diagnostics
+#include "compiler/base/stack.hpp"  // check_stack, run_on_new_stack, for the recursive stages
+
 namespace sdfc {
 
 struct SourceFile {
@@ -67,22 +70,5 @@ public:
 private:
     std::deque<std::unique_ptr<SourceFile>> files_;
 };
-
-// Levenshtein-nearest candidate within a small distance, or "" (for "did you mean").
-std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates);
-
-// Every recursive stage (parser, interpreter, lowering) calls this once per level: it
-// throws CompileError at `loc` when the current thread's C++ stack is nearly used up, so
-// input nested deeper than the stack allows is a diagnostic, never a stack overflow,
-// whatever the limits (--max-nesting, --max-recursion, --max-shape-depth) are raised to.
-void check_stack(Loc loc);
-bool stack_nearly_exhausted();  // the test alone (when making the Loc costs something)
-
-// The most stack this build gives a thread of its own: 4 GiB of address space (touched
-// only as deep as the input goes), less under sanitizers (see compiler/base/source.cpp).
-size_t max_thread_stack();
-// Runs `fn` on a new thread with a stack of `bytes` and waits for it; false (fn not run)
-// when no such thread can be made. `fn` must not throw.
-bool run_on_new_stack(size_t bytes, const std::function<void()>& fn);
 
 }  // namespace sdfc

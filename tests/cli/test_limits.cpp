@@ -151,7 +151,7 @@ TEST_CASE("scripts as deep as the default limits allow compile") {
         INFO(name);
         auto r = check(test::write_temp(name, text));
 #if defined(SDFC_TEST_TSAN)
-        // ThreadSanitizer caps the stack at 8 MB (compiler/base/source.cpp): the guard may stop these.
+        // ThreadSanitizer caps the stack at 8 MB (compiler/base/stack.cpp): the guard may stop these.
         CHECK((r.first == 0 || r.second.find("the C++ stack is nearly exhausted") != std::string::npos));
 #else
         CHECK(r == std::pair<int, std::string>{0, ""});

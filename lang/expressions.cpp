@@ -1,0 +1,407 @@
+// Expressions, calls of user functions and shapes, and the operators: an expression's
+// value, built as nodes of the scene's graph. Statements are in interpreter.cpp.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <functional>
+
+#include <fmt/format.h>
+
+#include "compiler/scene/lower.hpp"
+#include "lang/interp.hpp"
+
+namespace sdfc {
+
+// ---------------------------------------------------------------- expressions
+
+Value Interp::eval(const ast::Expr& e, Env* env) {
+    using K = ast::ExprKind;
+    check_stack(e.loc);
+    g->set_loc(e.loc);
+    switch (e.kind) {
+        case K::Number: {
+            if (!std::isfinite(float(e.number))) fail(e.loc, "this number is too large for a 32-bit float");
+            return Value::number(g->constant(float(e.number)));
+        }
+        case K::Bool:
+            return Value::boolean(g->constant(e.boolean ? 1.0f : 0.0f));
+        case K::String: {
+            Value v;
+            v.t = VT::String;
+            v.str = std::make_shared<const std::string>(e.text);
+            return v;
+        }
+        case K::Ident: {
+            if (Binding* b = env->find(e.text)) return b->value;
+            if (e.text == "time") return Value::number(opts.time ? g->constant(*opts.time) : g->input(Op::Time));
+            if (e.text == "pi") return Value::number(g->constant(3.14159265358979f));
+            if (e.text == "tau") return Value::number(g->constant(6.28318530717959f));
+            if (e.text == "e") return Value::number(g->constant(2.71828182845905f));
+            if (const BuiltinInfo* bi = find_builtin(e.text)) {
+                Value v;
+                v.t = VT::Function;
+                auto fn = std::make_shared<Callable>();
+                fn->name = bi->name;
+                fn->builtin = true;
+                fn->id = bi->id;
+                v.fn = fn;
+                return v;
+            }
+            std::vector<std::string> names = builtin_names();
+            for (Env* s = env; s; s = s->parent)
+                for (const auto& [n, b] : s->vars) names.push_back(n);
+            names.insert(names.end(), {"time", "pi", "tau", "e"});
+            std::string near = nearest_name(e.text, names);
+            fail(e.loc, near.empty() ? fmt::format("unknown name '{}'", e.text)
+                                     : fmt::format("unknown name '{}' (did you mean `{}`?)", e.text, near));
+        }
+        case K::Vector: {
+            std::vector<Value> items;
+            bool all_num = true;
+            for (const auto& el : e.elems) {
+                items.push_back(eval(*el, env));
+                all_num &= items.back().t == VT::Number;
+            }
+            if (all_num && items.size() >= 2 && items.size() <= 4) {
+                NodeId c[4];
+                for (size_t i = 0; i < items.size(); ++i) c[i] = items[i].c[0];
+                return Value::vector(c, int(items.size()));
+            }
+            if (all_num && items.size() == 1) {
+                // [x] is a list of one number
+            }
+            Value v;
+            v.t = VT::List;
+            v.depth = 1;
+            for (const Value& it : items) v.depth = std::max(v.depth, it.depth + 1);
+            // Lists built by a loop (`l = [l];`) nest without nesting the syntax.
+            if (v.depth > uint32_t(opts.limits.max_nesting))
+                fail(e.loc, fmt::format("lists nested deeper than {} levels (raise it with --max-nesting)", opts.limits.max_nesting));
+            v.list = std::make_shared<const std::vector<Value>>(std::move(items));
+            return v;
+        }
+        case K::Range: {
+            Value v;
+            v.t = VT::Range;
+            v.range.start = const_num(eval(*e.elems[0], env), e.elems[0]->loc, "a range's start");
+            v.range.end = const_num(eval(*e.elems[2], env), e.elems[2]->loc, "a range's end");
+            v.range.step = 1.0f;
+            if (e.elems[1]) {
+                v.range.step = const_num(eval(*e.elems[1], env), e.elems[1]->loc, "a range's step");
+                if (v.range.step == 0.0f || !std::isfinite(v.range.step)) fail(e.elems[1]->loc, "a range's step must not be zero");
+            }
+            if (!std::isfinite(v.range.start) || !std::isfinite(v.range.end)) fail(e.loc, "a range's ends must be finite");
+            return v;
+        }
+        case K::Unary:
+            return unary(e.un_op, eval(*e.lhs, env), e.loc);
+        case K::Binary: {
+            if (e.bin_op == ast::BinOp::And || e.bin_op == ast::BinOp::Or) {
+                Value a = eval(*e.lhs, env);
+                std::optional<bool> ka = const_truth(a, e.lhs->loc);
+                bool is_and = e.bin_op == ast::BinOp::And;
+                if (ka && *ka != is_and) return Value::boolean(g->constant(*ka ? 1.0f : 0.0f));
+                Value b = eval(*e.rhs, env);
+                NodeId tb = truth(b, e.rhs->loc);
+                if (ka) return Value::boolean(tb);
+                return Value::boolean(g->binary(is_and ? Op::And : Op::Or, truth(a, e.lhs->loc), tb));
+            }
+            Value a = eval(*e.lhs, env);
+            Value b = eval(*e.rhs, env);
+            return binary(e.bin_op, a, b, e.loc);
+        }
+        case K::Ternary: {
+            Value c = eval(*e.elems[0], env);
+            std::optional<bool> k = const_truth(c, e.elems[0]->loc);
+            if (k) return eval(*e.elems[*k ? 1 : 2], env);
+            NodeId cond = truth(c, e.elems[0]->loc);
+            Value a = eval(*e.elems[1], env), b = eval(*e.elems[2], env);
+            if (a.t == VT::Shape && b.t == VT::Shape && !g->depends_on_point(cond))
+                return Value::of_shape(choose(cond, a.shape, b.shape, e.loc));  // on time alone
+            if (!a.numeric() || a.t != b.t || a.n != b.n)
+                fail(e.loc, fmt::format("a choice on the point or time needs two numbers or vectors of one size, not {} and {}",
+                                        describe(a), describe(b)));
+            Value r = a;
+            for (int i = 0; i < a.n; ++i) r.c[i] = g->select(cond, a.c[i], b.c[i]);
+            return r;
+        }
+        case K::If: {
+            Value c = eval(*e.elems[0], env);
+            std::optional<bool> k = const_truth(c, e.elems[0]->loc);
+            if (!k) {
+                NodeId cond = truth(c, e.elems[0]->loc);
+                if (g->depends_on_point(cond)) fail(e.elems[0]->loc, "a shape cannot be chosen by a condition on the point");
+                // On time alone (GLSL, where time is iTime): both branches, chosen per frame.
+                ShapePtr a = to_shape(eval(*e.elems[1], env), e.elems[1]->loc, "a branch");
+                ShapePtr b = e.elems.size() > 2 && e.elems[2] ? to_shape(eval(*e.elems[2], env), e.elems[2]->loc, "a branch")
+                                                              : union_of({}, e.loc);
+                return Value::of_shape(choose(cond, a, b, e.loc));
+            }
+            if (*k) return eval(*e.elems[1], env);
+            if (e.elems.size() > 2 && e.elems[2]) return eval(*e.elems[2], env);
+            return Value::of_shape(union_of({}, e.loc));
+        }
+        case K::For: {
+            // for in modifier-target position: the union of the iterations.
+            std::vector<ShapePtr> shapes;
+            run_for(e.bindings, env, e.loc, [&](Env* body) {
+                Value v = e.block ? eval_block(*e.block, body, false) : eval(*e.body, body);
+                shapes.push_back(to_shape(v, e.loc, "the body of a for"));
+            });
+            return Value::of_shape(union_of(std::move(shapes), e.loc));
+        }
+        case K::Call: {
+            Value callee = eval(*e.callee, env);
+            return call_value(callee, e.args, env, e.loc);
+        }
+        case K::Index: {
+            Value v = eval(*e.lhs, env);
+            Value ix = eval(*e.rhs, env);
+            if (v.t == VT::List) {
+                float i = const_num(ix, e.rhs->loc, "an index");
+                if (i != std::floor(i)) fail(e.rhs->loc, fmt::format("index {} is not a whole number", i));
+                if (i < 0 || i >= float(v.list->size()))
+                    fail(e.rhs->loc, fmt::format("index {} is out of range for a list of {}", i, v.list->size()));
+                return (*v.list)[size_t(i)];
+            }
+            if (v.t != VT::Vector) fail(e.lhs->loc, fmt::format("only vectors and lists can be indexed, not {}", describe(v)));
+            NodeId in = num(ix, e.rhs->loc, "an index");
+            if (g->is_const(in)) {
+                float i = g->const_value(in);
+                if (i != std::floor(i)) fail(e.rhs->loc, fmt::format("index {} is not a whole number", i));
+                if (i < 0 || i >= v.n) fail(e.rhs->loc, fmt::format("index {} is out of range for {}", i, describe(v)));
+                return Value::number(v.c[int(i)]);
+            }
+            NodeId r = v.c[v.n - 1];
+            for (int i = v.n - 2; i >= 0; --i) r = g->select(g->binary(Op::Lt, in, g->constant(i + 0.5f)), v.c[i], r);
+            return Value::number(r);
+        }
+        case K::Swizzle: {
+            Value v = eval(*e.lhs, env);
+            if (v.t != VT::Vector && v.t != VT::Number)
+                fail(e.loc, fmt::format("'.{}' needs a vector, not {}", e.text, describe(v)));
+            if (e.text.size() > 4) fail(e.loc, fmt::format("swizzle '.{}' has more than 4 components", e.text));
+            NodeId c[4];
+            bool xyzw = false, rgba = false;
+            for (size_t i = 0; i < e.text.size(); ++i) {
+                char ch = e.text[i];
+                int idx = -1;
+                if (const char* p = std::strchr("xyzw", ch); p && ch) { idx = int(p - "xyzw"); xyzw = true; }
+                else if (const char* q = std::strchr("rgba", ch); q && ch) { idx = int(q - "rgba"); rgba = true; }
+                int n = v.t == VT::Number ? 1 : v.n;
+                if (idx < 0) fail(e.loc, fmt::format("'{}' is not a component name (use x y z w or r g b a)", ch));
+                if (idx >= n) fail(e.loc, fmt::format("'.{}' reads component {} of {}", e.text, ch, describe(v)));
+                c[i] = v.c[idx];
+            }
+            if (xyzw && rgba) fail(e.loc, fmt::format("'.{}' mixes xyzw and rgba letters", e.text));
+            if (e.text.size() == 1) return Value::number(c[0]);
+            return Value::vector(c, int(e.text.size()));
+        }
+        case K::Apply:
+            return apply(e, env);
+        case K::BlockExpr:
+            return eval_block(*e.block, env, env->field_scope);
+        case K::Field: {
+            float bound = 1.0f;
+            for (const auto& a : e.args) {
+                if (!a.name.empty() && a.name != "bound")
+                    fail(a.loc, fmt::format("unknown argument '{}' of field (did you mean `bound`?)", a.name));
+                bound = const_num(eval(*a.value, env), a.value->loc, "the field's bound");
+                if (!(bound > 0.0f) || !std::isfinite(bound)) fail(a.value->loc, "the field's bound must be a positive number");
+            }
+            if (e.args.size() > 1) fail(e.args[1].loc, "field takes one argument, bound");
+            Shape s{ShapeKind::Field, e.loc};
+            s.bound = bound;
+            const ast::Expr* body = e.body.get();
+            std::string param = e.text;
+            Loc ploc = e.loc;
+            pin_envs();  // the closure keeps env
+            s.field = [this, env, body, param, ploc](Graph&, const Vec3N& p) -> NodeId {
+                if (call_depth + 1 > opts.limits.max_recursion)
+                    fail(ploc, fmt::format("recursion deeper than {} calls (raise it with --max-recursion)", opts.limits.max_recursion));
+                count_calls(1, ploc);
+                struct Depth {
+                    int& d;
+                    ~Depth() { --d; }
+                } depth{++call_depth};
+                const size_t mark = envs.size();
+                Env* fe = new_env(env, true);
+                fe->vars[param] = Binding{Value::vector(p.data(), 3), false, ploc};
+                Value v = eval(*body, fe);
+                release_envs(mark);
+                if (v.t != VT::Number) fail(body->loc, fmt::format("a field must compute a number (the distance), not {}", describe(v)));
+                return v.c[0];
+            };
+            return Value::of_shape(make_shape(std::move(s)));
+        }
+    }
+    fail(e.loc, "internal: unknown expression");
+}
+
+Value Interp::call_value(const Value& callee, const std::vector<ast::Arg>& args, Env* env, Loc loc) {
+    if (callee.t == VT::Function) {
+        if (callee.fn->builtin) return call_builtin(builtin_info(callee.fn->id), args, env, loc);
+        return call_user(*callee.fn, args, env, loc);
+    }
+    if (callee.t == VT::Shape) {
+        // A shape applied to a point gives its distance there.
+        if (args.size() != 1 || !args[0].name.empty()) fail(loc, "a shape is applied to one point: s(p)");
+        Value p = eval(*args[0].value, env);
+        Vec3N pv = vec3(p, args[0].loc, "the point a shape is applied to", false);
+        count_calls(callee.shape->tree_size, loc);
+        NodeId d = lower_distance(*g, *callee.shape, pv);
+        return Value::number(d);
+    }
+    fail(loc, fmt::format("{} cannot be called", describe(callee)));
+}
+
+Value Interp::call_user(const Callable& fn, const std::vector<ast::Arg>& args, Env* env, Loc loc) {
+    const ast::Stmt& def = *fn.def;
+    std::vector<const ast::Expr*> given(def.params.size(), nullptr);
+    std::vector<Value> values(def.params.size());
+    size_t pos = 0;
+    bool named_seen = false;
+    for (const auto& a : args) {
+        size_t idx;
+        if (a.name.empty()) {
+            if (named_seen) fail(a.loc, "a positional argument cannot follow a named one");
+            if (pos >= def.params.size())
+                fail(a.loc, fmt::format("{} takes {} argument{}, but more were given", fn.name, def.params.size(),
+                                        def.params.size() == 1 ? "" : "s"));
+            idx = pos++;
+        } else {
+            named_seen = true;
+            auto it = std::find_if(def.params.begin(), def.params.end(), [&](const ast::Param& p) { return p.name == a.name; });
+            if (it == def.params.end()) {
+                std::vector<std::string> names;
+                for (const auto& p : def.params) names.push_back(p.name);
+                std::string near = nearest_name(a.name, names);
+                fail(a.loc, near.empty() ? fmt::format("{} has no parameter '{}'", fn.name, a.name)
+                                         : fmt::format("{} has no parameter '{}' (did you mean `{}`?)", fn.name, a.name, near));
+            }
+            idx = size_t(it - def.params.begin());
+            if (given[idx]) fail(a.loc, fmt::format("argument '{}' of {} is given twice", a.name, fn.name));
+        }
+        given[idx] = a.value.get();
+        values[idx] = eval(*a.value, env);
+    }
+    if (call_depth + 1 > opts.limits.max_recursion)
+        fail(loc, fmt::format("recursion deeper than {} calls in '{}' (raise it with --max-recursion)", opts.limits.max_recursion, fn.name));
+    count_calls(1, loc);
+    struct Depth {  // back out on any exit: the run goes on with the next statement after an error
+        int& d;
+        ~Depth() { --d; }
+    } depth{++call_depth};
+    const size_t mark = envs.size();
+    Env* callenv = new_env(fn.env);
+    callenv->field_scope = env->field_scope;
+    for (size_t i = 0; i < def.params.size(); ++i) {
+        const ast::Param& p = def.params[i];
+        if (!given[i]) {
+            if (!p.default_value) fail(loc, fmt::format("missing argument '{}' of {}", p.name, fn.name));
+            values[i] = eval(*p.default_value, callenv);
+        }
+        callenv->vars[p.name] = Binding{values[i], false, p.loc};
+    }
+    Value r = eval(*def.value, callenv);
+    release_envs(mark);
+    return r;
+}
+
+Value Interp::apply(const ast::Expr& e, Env* env) {
+    Value m = eval(*e.lhs, env);
+    if (m.t == VT::Function && m.fn->builtin) {
+        const BuiltinInfo& bi = builtin_info(m.fn->id);
+        if (bi.kind == BuiltinKind::Modifier || bi.kind == BuiltinKind::MaterialCtor)
+            m = call_builtin(bi, {}, env, e.lhs->loc);
+    }
+    if (m.t == VT::Material) {
+        auto mv = std::make_shared<ModifierVal>();
+        mv->id = Builtin::MaterialFn;
+        mv->name = "material";
+        mv->loc = e.lhs->loc;
+        mv->material = *m.mat;
+        m = Value{};
+        m.t = VT::Modifier;
+        m.mod = mv;
+    }
+    if (m.t != VT::Modifier)
+        fail(e.lhs->loc, fmt::format("{} is written before a shape but is not an operation{}", describe(m),
+                                     m.t == VT::Shape ? " (is a ';' missing after it?)" : ""));
+    Value t = eval(*e.rhs, env);
+    ShapePtr target = to_shape(t, e.rhs->loc, fmt::format("the target of {}", m.mod->name).c_str());
+    return Value::of_shape(apply_modifier(*m.mod, target, e.loc));
+}
+
+// ---------------------------------------------------------------- operators
+
+Value Interp::componentwise(const Value& a, Loc loc, const std::function<NodeId(NodeId)>& f) {
+    Value r = a;
+    if (r.t == VT::Bool) r.t = VT::Number;
+    for (int i = 0; i < a.n; ++i) r.c[i] = checked(f(a.c[i]), loc);
+    return r;
+}
+
+Value Interp::componentwise2(const Value& a, const Value& b, Loc loc, const std::function<NodeId(NodeId, NodeId)>& f) {
+    if (a.t == VT::Vector && b.t == VT::Vector && a.n != b.n)
+        fail(loc, fmt::format("vector sizes differ: {} and {} components", a.n, b.n));
+    Value r = a.t == VT::Vector ? a : b;
+    if (r.t == VT::Bool) r.t = VT::Number;
+    int n = std::max(a.t == VT::Vector ? a.n : 1, b.t == VT::Vector ? b.n : 1);
+    r.n = uint8_t(n);
+    for (int i = 0; i < n; ++i) r.c[i] = checked(f(a.c[a.t == VT::Vector ? i : 0], b.c[b.t == VT::Vector ? i : 0]), loc);
+    return r;
+}
+
+Value Interp::unary(ast::UnOp op, const Value& a, Loc loc) {
+    if (op == ast::UnOp::Not) {
+        return Value::boolean(g->unary(Op::Not, truth(a, loc)));
+    }
+    if (a.t != VT::Number && a.t != VT::Vector) fail(loc, fmt::format("cannot negate {}", describe(a)));
+    return componentwise(a, loc, [&](NodeId x) { return g->neg(x); });
+}
+
+Value Interp::binary(ast::BinOp op, const Value& a, const Value& b, Loc loc) {
+    using B = ast::BinOp;
+    auto arith_ok = [&](const Value& v) { return v.t == VT::Number || v.t == VT::Vector; };
+    if (op == B::Eq || op == B::Ne) {
+        if (a.t == VT::String && b.t == VT::String) {
+            bool eq = *a.str == *b.str;
+            return Value::boolean(g->constant((eq == (op == B::Eq)) ? 1.0f : 0.0f));
+        }
+        if (a.numeric() && b.numeric()) {
+            if (a.n != b.n) fail(loc, fmt::format("cannot compare {} with {}", describe(a), describe(b)));
+            NodeId r = g->constant(op == B::Eq ? 1.0f : 0.0f);
+            for (int i = 0; i < a.n; ++i) {
+                NodeId c = g->binary(op == B::Eq ? Op::Eq : Op::Ne, a.c[i], b.c[i]);
+                r = i == 0 ? c : g->binary(op == B::Eq ? Op::And : Op::Or, r, c);
+            }
+            return Value::boolean(r);
+        }
+        fail(loc, fmt::format("cannot compare {} with {}", describe(a), describe(b)));
+    }
+    if (op == B::Lt || op == B::Le || op == B::Gt || op == B::Ge) {
+        if (a.t != VT::Number || b.t != VT::Number)
+            fail(loc, fmt::format("'{}' compares numbers, not {} and {}", op == B::Lt ? "<" : op == B::Le ? "<=" : op == B::Gt ? ">" : ">=",
+                                  describe(a), describe(b)));
+        NodeId x = a.c[0], y = b.c[0];
+        switch (op) {
+            case B::Lt: return Value::boolean(g->binary(Op::Lt, x, y));
+            case B::Le: return Value::boolean(g->binary(Op::Le, x, y));
+            case B::Gt: return Value::boolean(g->binary(Op::Lt, y, x));
+            default: return Value::boolean(g->binary(Op::Le, y, x));
+        }
+    }
+    if (!arith_ok(a) || !arith_ok(b)) {
+        const char* sym = op == B::Add ? "+" : op == B::Sub ? "-" : op == B::Mul ? "*" : op == B::Div ? "/" : "%";
+        fail(loc, fmt::format("cannot apply '{}' to {} and {}", sym, describe(a), describe(b)));
+    }
+    Op o = op == B::Add ? Op::Add : op == B::Sub ? Op::Sub : op == B::Mul ? Op::Mul : op == B::Div ? Op::Div : Op::Mod;
+    return componentwise2(a, b, loc, [&](NodeId x, NodeId y) {
+        if ((o == Op::Div || o == Op::Mod) && g->is_const(y) && g->const_value(y) == 0.0f)
+            fail(loc, o == Op::Div ? "division by zero" : "modulo by zero");
+        return g->binary(o, x, y);
+    });
+}
+
+}  // namespace sdfc
