@@ -2,12 +2,13 @@
 //
 //   header comment (what it is, how to use it, the uniforms)
 //   render settings as constants          SDF_MAX_STEPS, SDF_EPSILON, ... (render(...) of the script)
-//   kRendererHead                         struct Material, struct SdfLight, setting globals
-//   sdf_noise (only if the scene uses it) compiler/ir/op_math.hpp's kGlslNoise
+//   kRendererHead                         struct Material, struct SdfLight, setting globals (head.glsl)
+//   sdf_noise (only if the scene uses it) kGlslNoise, compiler/ir/noise.glsl
 //   float map(vec3 p)                     the distance program (compiler/bytecode/codegen.cpp)
 //   Material sdf_material(vec3 p)         the 11 material channels
 //   void sdf_settings()                   camera, lights, ambient, background (may use sdf_time)
-//   kRendererBody                         the renderer, a twin of runtime/cpu/tracer.cpp
+//   kRendererBody                         the renderer, a twin of runtime/cpu/tracer.cpp (camera.glsl,
+//                                         marching.glsl, trace.glsl; see glsl_renderer.hpp)
 //   the target's entry point              mainImage / main
 //
 // The three scene functions are generated from register Programs made by the same codegen as

@@ -1,9 +1,12 @@
 // Scalar semantics shared by the constant folder and the VM, written to match GLSL's
 // definitions (mod = x - y*floor(x/y), sign(0) = 0), and the GLSL text of the helpers that
-// GLSL lacks. Keep each C++ helper and its GLSL twin side by side.
+// GLSL lacks (kGlslNoise: compiler/ir/noise.glsl, embedded by the build). Keep each C++ helper
+// and its GLSL twin in step.
 #pragma once
 #include <cmath>
 #include <cstdint>
+
+#include "compiler/ir/noise.glsl.hpp"
 
 namespace sdfc::om {
 
@@ -16,7 +19,7 @@ inline float mod_(float a, float b) { return a - b * std::floor(a / b); }
 inline float pow_(float a, float b) { return std::pow(a, b); }
 
 // Gradient noise (Perlin's improved noise with an integer hash instead of a permutation
-// table, so GLSL computes the same bits). Range about [-1, 1]; Lipschitz bound kNoiseLipschitz.
+// table, so GLSL computes the same bits: noise.glsl, its twin). Range about [-1, 1]; Lipschitz bound kNoiseLipschitz.
 inline uint32_t hash3(uint32_t x, uint32_t y, uint32_t z) {
     uint32_t h = x * 0x8da6b343u ^ y * 0xd8163841u ^ z * 0xcb1ab31fu;
     h ^= h >> 16; h *= 0x7feb352du; h ^= h >> 15; h *= 0x846ca68bu; h ^= h >> 16;
@@ -46,34 +49,5 @@ inline float noise3(float px, float py, float pz) {
 }
 // Bound on |grad noise3| (measured over dense samples plus margin; see tests/test_lipschitz.cpp).
 inline constexpr float kNoiseLipschitz = 3.0f;
-
-inline constexpr const char* kGlslNoise = R"(uint sdf_hash3(uint x, uint y, uint z) {
-    uint h = x * 0x8da6b343u ^ y * 0xd8163841u ^ z * 0xcb1ab31fu;
-    h ^= h >> 16; h *= 0x7feb352du; h ^= h >> 15; h *= 0x846ca68bu; h ^= h >> 16;
-    return h;
-}
-float sdf_grad3(uint h, vec3 p) {
-    uint g = h & 15u;
-    float u = g < 8u ? p.x : p.y;
-    float v = g < 4u ? p.y : ((g == 12u || g == 14u) ? p.x : p.z);
-    return ((g & 1u) != 0u ? -u : u) + ((g & 2u) != 0u ? -v : v);
-}
-float sdf_noise(vec3 q) {
-    vec3 f = floor(q);
-    uvec3 i = uvec3(ivec3(f));
-    vec3 x = q - f;
-    vec3 w = x * x * x * (x * (x * 6.0 - 15.0) + 10.0);
-    float g000 = sdf_grad3(sdf_hash3(i.x, i.y, i.z), x);
-    float g100 = sdf_grad3(sdf_hash3(i.x + 1u, i.y, i.z), x - vec3(1, 0, 0));
-    float g010 = sdf_grad3(sdf_hash3(i.x, i.y + 1u, i.z), x - vec3(0, 1, 0));
-    float g110 = sdf_grad3(sdf_hash3(i.x + 1u, i.y + 1u, i.z), x - vec3(1, 1, 0));
-    float g001 = sdf_grad3(sdf_hash3(i.x, i.y, i.z + 1u), x - vec3(0, 0, 1));
-    float g101 = sdf_grad3(sdf_hash3(i.x + 1u, i.y, i.z + 1u), x - vec3(1, 0, 1));
-    float g011 = sdf_grad3(sdf_hash3(i.x, i.y + 1u, i.z + 1u), x - vec3(0, 1, 1));
-    float g111 = sdf_grad3(sdf_hash3(i.x + 1u, i.y + 1u, i.z + 1u), x - vec3(1, 1, 1));
-    return mix(mix(mix(g000, g100, w.x), mix(g010, g110, w.x), w.y),
-               mix(mix(g001, g101, w.x), mix(g011, g111, w.x), w.y), w.z);
-}
-)";
 
 }  // namespace sdfc::om

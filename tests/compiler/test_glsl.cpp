@@ -1,6 +1,6 @@
 // The GLSL backend: every opcode through the emitter, every example through every target,
 // each checked by glslangValidator when it is installed (else skipped with a warning), plus
-// the shape of each target's output.
+// the shape of each target's output, and that every function the shaders call is defined.
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -19,6 +21,7 @@
 
 #include "compiler/glsl/glsl.hpp"
 #include "compiler/glsl/glsl_emit.hpp"
+#include "compiler/glsl/glsl_renderer.hpp"
 #include "lang/load.hpp"
 #include "support.hpp"
 
@@ -136,6 +139,45 @@ std::string template_expr(Op op) {
     return strip_outer(t);
 }
 
+// GLSL text without its // comments.
+std::string strip_comments(const std::string& src) {
+    std::string out;
+    std::stringstream ss(src);
+    for (std::string line; std::getline(ss, line);) out += line.substr(0, line.find("//")) + "\n";
+    return out;
+}
+
+// The names `src` calls: an identifier followed by '(' (so also constructors and keywords).
+std::set<std::string> called(const std::string& src) {
+    static const std::regex call_re(R"re(\b([A-Za-z_]\w*)\s*\()re");
+    std::set<std::string> out;
+    const std::string code = strip_comments(src);
+    for (std::sregex_iterator it(code.begin(), code.end(), call_re), end; it != end; ++it) out.insert((*it)[1]);
+    return out;
+}
+
+// The functions and structs `src` defines: a line starting `type name(` or `struct Name`.
+std::set<std::string> defined(const std::string& src) {
+    static const std::regex def_re(R"re(^(?:struct\s+([A-Za-z_]\w*)|[A-Za-z_]\w*\s+([A-Za-z_]\w*)\s*\())re");
+    std::set<std::string> out;
+    std::stringstream ss(strip_comments(src));
+    for (std::string line; std::getline(ss, line);) {
+        std::smatch m;
+        if (std::regex_search(line, m, def_re)) out.insert(m[1].matched ? m[1].str() : m[2].str());
+    }
+    return out;
+}
+
+// The sdf_ helpers that opcodes.def's GLSL templates call.
+std::set<std::string> template_helpers() {
+    static const std::regex helper_re(R"re(\b(sdf_\w+)\s*\()re");
+    std::set<std::string> out;
+    for (int i = 0; i < kOpCount; ++i) {
+        const std::string t(op_info(static_cast<Op>(i)).glsl);
+        for (std::sregex_iterator it(t.begin(), t.end(), helper_re), end; it != end; ++it) out.insert((*it)[1]);
+    }
+    return out;
+}
 
 }  // namespace
 
@@ -252,6 +294,71 @@ TEST_CASE("glsl: every example compiles for every target", "[glsl][examples]") {
     }
 }
 
+TEST_CASE("glsl: every sdf_ function a shader calls is defined in it, template helpers included", "[glsl]") {
+    // Every example and a few scripts through every target; the scripts make sure each helper
+    // an opcodes.def template calls (sdf_noise) is used by some scene.
+    SourceManager sm;
+    std::vector<std::pair<std::string, Scene>> scenes;
+    InterpretOptions o;
+    o.time = std::nullopt;
+    for (const std::string& path : example_files()) scenes.emplace_back(path, load_scene(sm, path, o));
+    for (const char* src : {"sphere(1);", "displace(0.1, 2) box(1);",
+                            "material(color = [noise([time, 1, 2]), 1, 1]) field (p) -> length(p) - 1;"})
+        scenes.emplace_back(src, interpret_source(sm, sm.add("scene.sdf", src), o));
+    const std::set<std::string> helpers = template_helpers();
+    std::set<std::string> used;
+    for (const auto& [what, scene] : scenes)
+        for (GlslTarget t : {GlslTarget::Shadertoy, GlslTarget::Glsl330, GlslTarget::Html}) {
+            std::string code = emit_glsl(scene, t);
+            if (t == GlslTarget::Html) code = html_shader(code);
+            const std::set<std::string> calls = called(code), defs = defined(code);
+            INFO(what << ", target " << static_cast<int>(t));
+            for (const std::string& c : calls) {
+                if (c.rfind("sdf_", 0) != 0) continue;
+                INFO("calls " << c);
+                CHECK(defs.count(c) == 1);
+                if (helpers.count(c)) used.insert(c);
+            }
+            for (const std::string& h : helpers) {
+                INFO("defines " << h << " without calling it");
+                CHECK((defs.count(h) == 0 || calls.count(h) == 1));
+            }
+        }
+    for (const std::string& h : helpers) {
+        INFO("no scene here calls " << h << ": add a script that uses its opcode");
+        CHECK(used.count(h) == 1);
+    }
+}
+
+TEST_CASE("glsl: every function the renderer's .glsl files call is defined", "[glsl]") {
+    // Builtins, constructors and keywords the renderer may use; a new builtin goes here.
+    const std::set<std::string> glsl = {"abs", "asin", "clamp", "cos", "cross", "dot", "exp", "floor", "isinf", "isnan",
+                                        "length", "max", "min", "mix", "normalize", "pow", "radians", "reflect", "refract",
+                                        "sin", "sqrt", "tan", "uintBitsToFloat", "bool", "float", "int", "uint", "vec2",
+                                        "vec3", "vec4", "ivec3", "uvec3", "if", "for", "while", "return"};
+    // What compiler/glsl/glsl.cpp writes from the scene between kRendererHead and kRendererBody.
+    const std::set<std::string> scene = {"map", "sdf_material", "sdf_settings"};
+    struct Part {
+        const char* name;
+        std::string text;
+        std::set<std::string> also;
+    };
+    const Part parts[] = {{"renderer", std::string(glsl::kRendererHead) + std::string(glsl::kRendererBody), scene},
+                          {"noise", std::string(om::kGlslNoise), {}}};
+    for (const Part& p : parts) {
+        const std::set<std::string> defs = defined(p.text);
+        for (const std::string& c : called(p.text)) {
+            INFO(p.name << " calls " << c);
+            CHECK((defs.count(c) + glsl.count(c) + p.also.count(c)) > 0);
+        }
+    }
+    // The entry points of every target call these.
+    const std::set<std::string> defs = defined(std::string(glsl::kRendererBody));
+    CHECK(defs.count("sdf_render") == 1);
+    CHECK(defs.count("sdf_mouse_orbit") == 1);
+    CHECK(defined(std::string(om::kGlslNoise)).count("sdf_noise") == 1);
+}
+
 TEST_CASE("glsl: shadertoy output is paste-ready and readable", "[glsl]") {
     const std::string st = glsl_of_text(
         "camera(position = [0, 2, 6 + sin(time)], target = [0, 0, 0]);\n"
@@ -325,6 +432,9 @@ TEST_CASE("glsl: the html page is self-contained", "[glsl][html]") {
     CHECK(page.find("http://") == std::string::npos);
     CHECK(page.find("https://") == std::string::npos);
     CHECK(page.find("@SHADER@") == std::string::npos);
+    CHECK(page.find("@PAGE_JS@") == std::string::npos);
+    CHECK(page.find("@USES_TIME@") == std::string::npos);
+    CHECK(page.find("var usesTime = false;") != std::string::npos);
     CHECK(page.find("capture") != std::string::npos);
     CHECK(page.find("id=\"play\"") != std::string::npos);
     CHECK(page.find("id=\"time\"") != std::string::npos);
