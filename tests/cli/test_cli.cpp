@@ -54,7 +54,7 @@ TEST_CASE("check reports script errors with a caret and exit 1") {
     CHECK(missing.err == "sdfc: error: cannot open '/nonexistent/x.sdf'\n");
 }
 
-TEST_CASE("render writes the image; an error leaves no file") {
+TEST_CASE("render writes the image, an error leaves no file") {
     std::string out = test::temp_dir() + "/tori.png";
     fs::remove(out);
     auto r = run_sdfc("render '" + test::example("three-tori.sdf") + "' -o '" + out + "' --width 160 --height 90 --samples 1 --quiet");
@@ -156,7 +156,7 @@ double field(const std::string& line, const std::string& key) {
 }
 }  // namespace
 
-TEST_CASE("bench prints one line of times and evaluations; --baseline evaluates more") {
+TEST_CASE("bench prints one line of times and evaluations, --baseline evaluates more") {
     const std::string scene = test::example("three-tori.sdf");
     auto fast = run_sdfc("bench '" + scene + "' --width 96 --height 54 --samples 1 --repeat 2 --threads 2");
     REQUIRE(fast.status == 0);

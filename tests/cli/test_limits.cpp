@@ -166,7 +166,7 @@ TEST_CASE("flag --max-file-size") {
     CHECK(check(s).first == 0);
 }
 
-TEST_CASE("flag --max-pixels (width x height x samples) and --max-frames; no output is written") {
+TEST_CASE("flag --max-pixels (width x height x samples) and --max-frames, no output is written") {
     std::string s = test::write_temp("lim_px.sdf", "render(width = 200, height = 100, samples = 4);\nsphere(1);\n");
     std::string out = test::temp_dir() + "/lim_px.png";
     fs::remove(out);

@@ -28,7 +28,7 @@ TEST_CASE("unknown names suggest the nearest known one") {
           "test.sdf:1:8: error: render has no parameter 'widht' (did you mean `width`?)");
 }
 
-TEST_CASE("columns count characters; an error at the end of the file points after the last token") {
+TEST_CASE("columns count characters, and an error at the end of the file points after the last token") {
     CHECK(error_of("let s = \"\u00fc\u00fc\u00fc\"; sphere(q);") ==
           "test.sdf:1:23: error: unknown name 'q'\n"
           "let s = \"\u00fc\u00fc\u00fc\"; sphere(q);\n"
@@ -37,7 +37,7 @@ TEST_CASE("columns count characters; an error at the end of the file points afte
           "test.sdf:2:5: error: expected ')'\n"
           "box(\n"
           "    ^\n");
-    CHECK(first_error_line("union {\n  sphere(1);\n\n\n") == "test.sdf:2:12: error: expected '}'");
+    CHECK(first_error_line("union {\n  sphere(1);\n\n\n") == "test.sdf:2:13: error: expected '}'");
 }
 
 TEST_CASE("a def names each parameter once") {
@@ -94,7 +94,7 @@ TEST_CASE("several independent errors are all reported") {
     CHECK(e.find("test.sdf:3:1: error: missing argument 'minor' of torus") != std::string::npos);
 }
 
-TEST_CASE("var is for field blocks; let cannot be reassigned") {
+TEST_CASE("var is for field blocks, let cannot be reassigned") {
     CHECK(first_error_line("var x = 1;") == "test.sdf:1:1: error: 'var' is only allowed inside a field block; use 'let' for a constant");
     CHECK(first_error_line("field (p) -> { let d = 1; d = 2; d };") ==
           "test.sdf:1:27: error: 'd' is a constant (declared with let at line 1); declare it with var to reassign it");

@@ -31,7 +31,7 @@ TEST_CASE("defs may be used before the line that defines them") {
     CHECK(close(dist_of("thing();\ndef thing() = sphere(2);", 0, 0, 0), -2));
 }
 
-TEST_CASE("for unions its iterations; nested bindings; vectors") {
+TEST_CASE("for unions its iterations, nested bindings, vectors") {
     const char* ring = "for (i = [0 : 7]) rotate(y = 45 * i) translate([2, 0, 0]) sphere(0.2);";
     CHECK(close(dist_of(ring, 2, 0, 0), -0.2));
     CHECK(close(dist_of(ring, 0, 0, 2), -0.2));
@@ -53,7 +53,7 @@ TEST_CASE("if/else at statement level and ?: in expressions") {
     CHECK(close(dist_of("sphere(true && !false ? 1 : 2);", 0, 0, 0), -1));
 }
 
-TEST_CASE("vectors broadcast like GLSL; swizzles and indexing") {
+TEST_CASE("vectors broadcast like GLSL, swizzles and indexing") {
     CHECK(close(dist_of("translate([1, 2, 3] * 2 - 1) sphere(1);", 1, 3, 5), -1));
     CHECK(close(dist_of("let v = [1, 2, 3]; translate(v.zyx) sphere(0.5);", 3, 2, 1), -0.5));
     CHECK(close(dist_of("let v = [1, 2, 3]; sphere(v[2] + v.x);", 0, 0, 0), -4));
@@ -161,7 +161,7 @@ TEST_CASE("scene settings are read") {
     CHECK(s.render.max_bounces == 1);
 }
 
-TEST_CASE("materials are values and modifiers; the inner one wins") {
+TEST_CASE("materials are values and modifiers, the inner one wins") {
     auto c = test::compile_text(
         "let gold = material(color = [0.9, 0.7, 0.2], specular = 0.6, shininess = 64);\n"
         "material(color = [1, 0, 0]) { material(gold) sphere(1); translate([3, 0, 0]) sphere(1); }\n"

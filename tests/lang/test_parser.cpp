@@ -374,7 +374,7 @@ TEST_CASE("statements", "[parser]") {
     CHECK(sx1(R"(import "a b/c.sdf";)") == "import \"a b/c.sdf\"");
 }
 
-TEST_CASE("statements ending with a block need no ';'", "[parser]") {
+TEST_CASE("statements ending with a block need no semicolon", "[parser]") {
     Parsed p = parse_text("difference { box(1); sphere(0.6); }\nsphere(2);\n"
                           "union { a; } ;\n"
                           "for (i = [0:1]) translate([i,0,0]) { box(1); } b;\n"

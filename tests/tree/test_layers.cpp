@@ -142,3 +142,19 @@ TEST_CASE("no raw string literal over 40 lines inside C++", "[tree]") {
     for (const std::string& b : bad) UNSCOPED_INFO(b);
     CHECK(bad.empty());
 }
+
+TEST_CASE("no test name holds a semicolon (ctest would split it and silently run nothing)", "[tree]") {
+    const std::regex name_re(R"re((TEST_CASE|TEMPLATE_TEST_CASE|SCENARIO)\s*\(\s*"([^"]*)")re");
+    std::vector<std::string> bad;
+    for (const std::string& rel : source_files()) {
+        if (rel.rfind("tests/", 0) != 0 || !is_cxx(rel)) continue;
+        const auto lines = lines_of(rel);
+        for (size_t i = 0; i < lines.size(); ++i) {
+            std::smatch m;
+            if (std::regex_search(lines[i], m, name_re) && m[2].str().find(';') != std::string::npos)
+                bad.push_back(rel + ":" + std::to_string(i + 1) + ": " + m[2].str());
+        }
+    }
+    for (const std::string& b : bad) UNSCOPED_INFO(b);
+    CHECK(bad.empty());
+}
