@@ -1,11 +1,12 @@
 // IR Graph -> register Program: instruction selection (immediate forms, MulAddI fusion),
-// then linear-scan register allocation in SSA order.
+// then linear-scan register allocation in SSA order (the policy of regalloc.hpp).
 #include <algorithm>
 #include <limits>
 
 #include <fmt/format.h>
 
 #include "compiler/bytecode/program.hpp"
+#include "compiler/bytecode/regalloc.hpp"
 
 namespace sdfc {
 namespace {
@@ -104,16 +105,11 @@ Program codegen(const Graph& g, const std::vector<NodeId>& roots, const std::vec
 
     Program p;
     std::vector<int32_t> reg(n, -1);
-    std::vector<uint16_t> free_regs;
-    uint32_t next_reg = 0;
+    std::vector<uint16_t> free_stack;
+    RegPool pool(free_stack, n + 1);  // each node's value is emitted at most once
     auto alloc = [&]() -> uint16_t {
-        if (!free_regs.empty()) {
-            uint16_t r = free_regs.back();
-            free_regs.pop_back();
-            return r;
-        }
-        if (next_reg >= 0xFFFF) throw CompileError(Loc{}, "the program needs more than 65535 registers");
-        return static_cast<uint16_t>(next_reg++);
+        if (pool.exhausted()) throw CompileError(Loc{}, "the program needs more than 65535 registers");
+        return pool.alloc();
     };
     auto emit = [&](NodeId id, const Sel& s) {
         Instr in{s.op};
@@ -129,7 +125,7 @@ Program codegen(const Graph& g, const std::vector<NodeId>& roots, const std::vec
             if (a == kNoNode || last[a] != id || reg[a] < 0) continue;
             bool dup = false;
             for (int q = 0; q < j; ++q) dup |= args[q] == a;
-            if (!dup) free_regs.push_back(static_cast<uint16_t>(reg[a]));
+            if (!dup) pool.release(static_cast<uint16_t>(reg[a]));
         }
         in.out = alloc();
         reg[id] = in.out;
@@ -150,12 +146,12 @@ Program codegen(const Graph& g, const std::vector<NodeId>& roots, const std::vec
             }
         emit(static_cast<NodeId>(i), s);
     }
-    p.num_regs = std::max<uint32_t>(next_reg, 1);
+    p.num_regs = pool.used();
     for (NodeId r : roots) {
         if (reg[r] < 0) emit(r, Sel{Op::Const, kNoNode, kNoNode, kNoNode, g.const_value(r), true});
         p.outputs.push_back(static_cast<uint16_t>(reg[r]));
     }
-    p.num_regs = std::max<uint32_t>(next_reg, 1);
+    p.num_regs = pool.used();
     p.output_names = names;
     p.output_names.resize(roots.size());
     for (size_t i = 0; i < roots.size(); ++i)

@@ -20,6 +20,21 @@ struct Instr {
 };
 static_assert(sizeof(Instr) == 16);
 
+// What an evaluator needs of a tape at eval time: evaluators own only scratch (a register
+// file of num_regs), so one evaluator runs any tape that fits, Fidget's model. A Program,
+// an interval Tape and a simplified leaf tape (runtime/eval/tape.hpp, simplify.hpp) each give
+// one with view(); the view borrows their storage.
+struct TapeView {
+    static constexpr uint32_t kUncounted = 0xFFFFFFFFu;
+    const Instr* code = nullptr;
+    uint32_t len = 0;
+    const uint16_t* outputs = nullptr;  // register of each output
+    uint32_t num_outputs = 0;
+    uint32_t num_regs = 0;              // registers the code uses (0: unknown, the caller sized the evaluator)
+    uint32_t choices = kUncounted;      // min/max/select ops in code: interval choice slots
+    uint16_t output(uint32_t i = 0) const { return outputs[i]; }
+};
+
 struct Program {
     std::vector<Instr> code;
     std::vector<Loc> locs;          // per instruction: the script location that made it
@@ -27,6 +42,10 @@ struct Program {
     std::vector<uint16_t> outputs;  // register of each output
     std::vector<std::string> output_names;
     bool uses_time = false;
+
+    TapeView view() const {
+        return {code.data(), uint32_t(code.size()), outputs.data(), uint32_t(outputs.size()), num_regs};
+    }
 };
 
 // Linear-scan register allocation over the live nodes reachable from `roots`; constant

@@ -1,4 +1,4 @@
-// Interval semantics of every opcode, the batch interval evaluator and tape simplification.
+// Interval semantics of every opcode and the batch interval evaluator.
 //
 // Exactness. The VM's arithmetic is IEEE single precision with round-to-nearest, which is
 // monotonic: x <= y implies fl(x) <= fl(y). So for an op that is monotonic in each operand
@@ -11,37 +11,21 @@
 // om::min_ / om::max_ make, so a decided choice is the VM's choice at every point.
 #include "runtime/eval/interval.hpp"
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
-#include <iterator>
 #include <new>
+#include <span>
+
+#include "runtime/eval/simd.hpp"
 
 // A new opcode must get its interval semantics here: a missing case is an error.
 #pragma GCC diagnostic error "-Wswitch"
 
 namespace sdfc {
 namespace {
-
-#if defined(__GNUC__)
-#define SDFC_IV_INLINE __attribute__((always_inline)) inline
-#else
-#define SDFC_IV_INLINE inline
-#endif
-
-#if defined(__clang__)
-#define SDFC_IVDEP _Pragma("clang loop vectorize(assume_safety)")
-#elif defined(__GNUC__)
-#define SDFC_IVDEP _Pragma("GCC ivdep")
-#else
-#define SDFC_IVDEP
-#endif
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -406,23 +390,7 @@ float* alloc_floats(size_t count) {  // uninitialised: a register is written bef
     return static_cast<float*>(p);
 }
 
-template <Op O>
-constexpr bool choice_op() {
-    return O == Op::Min || O == Op::Max || O == Op::MinI || O == Op::MaxI || O == Op::Select;
-}
-
 }  // namespace
-
-namespace {
-constexpr uint64_t kChoiceMask = 0
-#define OP(name, mn, ar, imm, sem, glsl) | (choice_op<Op::name>() ? uint64_t(1) << int(Op::name) : 0)
-#include "compiler/ir/opcodes.def"
-#undef OP
-    ;
-static_assert(kOpCount <= 64);
-}  // namespace
-
-bool is_choice_op(Op op) { return (kChoiceMask >> int(op)) & 1; }
 
 Interval eval_interval(Op op, Interval a, Interval b, Interval c, float k, uint8_t* choice) {
     Interval r{};
@@ -437,63 +405,6 @@ Interval eval_interval(Op op, Interval a, Interval b, Interval c, float k, uint8
     return r;
 }
 
-Tape Tape::from(const Program& p, int output) {
-    Tape t;
-    t.code = p.code;
-    t.out = p.outputs.at(static_cast<size_t>(output));
-    t.recount();
-    t.num_regs = std::max(t.num_regs, p.num_regs);
-    t.link();
-    return t;
-}
-
-void Tape::recount() {
-    uint32_t regs = uint32_t(out) + 1, ch = 0;
-    for (const Instr& in : code) {
-        regs = std::max<uint32_t>(regs, uint32_t(in.out) + 1);
-        ch += is_choice_op(in.op);
-    }
-    num_regs = regs;
-    choices = ch;
-}
-
-void Tape::link() {
-    const size_t n = code.size();
-    links.resize(n);
-    thread_local std::vector<uint32_t> last;
-    last.assign(std::max<uint32_t>(num_regs, uint32_t(out) + 1), kNone);
-    const size_t nregs = last.size();
-    bool regs_ok = true;
-    if (!well_formed)
-        for (const Instr& in : code) regs_ok &= (in.out < nregs) & (in.a < nregs) & (in.b < nregs) & (in.c < nregs);
-    if (!regs_ok) {
-        linked = false;
-        return;
-    }
-    uint32_t sl = 0;
-    for (size_t i = 0; i < n; ++i) {
-        const Instr& in = code[i];
-        Link& l = links[i];
-        // Unused operand fields hold some register number: their "def" is never read.
-        l.def[0] = last[in.a];
-        l.def[1] = last[in.b];
-        l.def[2] = last[in.c];
-        const uint32_t ch = uint32_t((kChoiceMask >> int(in.op)) & 1);
-        l.slot = ch ? sl : kNone;
-        sl += ch;
-        last[in.out] = uint32_t(i);
-    }
-    choices = sl;
-    out_def = last[out];
-    linked = true;
-    if (!well_formed) {
-        // A tape reading unwritten registers cannot be followed by def links.
-        for (size_t i = 0; i < n && linked; ++i)
-            for (int j = 0; j < kOpInfo[int(code[i].op)].arity; ++j) linked &= links[i].def[j] != kNone;
-        well_formed = linked;
-    }
-}
-
 IntervalEvaluator::IntervalEvaluator(uint32_t max_regs, uint32_t max_choices)
     : max_regs_(std::max<uint32_t>(max_regs, 1)),
       max_choices_(max_choices),
@@ -503,11 +414,31 @@ IntervalEvaluator::IntervalEvaluator(uint32_t max_regs, uint32_t max_choices)
       hi_(hi_store_.get()),
       choices_(new uint8_t[size_t(max_choices) * kIvLanes + 64]) {}  // + 64: whole-vector reads past a row
 
-void IntervalEvaluator::eval(const Tape& t, const float* xlo, const float* xhi, const float* ylo, const float* yhi,
+void IntervalEvaluator::reserve(uint32_t regs, uint32_t choices) {
+    if (regs > max_regs_) {
+        lo_store_.reset(alloc_floats(size_t(regs) * kIvLanes));
+        hi_store_.reset(alloc_floats(size_t(regs) * kIvLanes));
+        lo_ = lo_store_.get();
+        hi_ = hi_store_.get();
+        max_regs_ = regs;
+    }
+    if (choices > max_choices_) {
+        choices_.reset(new uint8_t[size_t(choices) * kIvLanes + 64]);
+        max_choices_ = choices;
+    }
+}
+
+void IntervalEvaluator::eval(const TapeView& t, const float* xlo, const float* xhi, const float* ylo, const float* yhi,
                              const float* zlo, const float* zhi, int n, float time) {
+    uint32_t nch = t.choices;
+    if (nch == TapeView::kUncounted) {
+        nch = 0;
+        for (uint32_t i = 0; i < t.len; ++i) nch += is_choice_op(t.code[i].op);
+    }
+    reserve(t.num_regs, nch);
     const int m = (n + 7) / 8 * 8;  // lanes computed (whole vectors); padding copies lane n-1
     stride_ = m;
-    out_ = t.out;
+    out_ = t.output(0);
     float* const L = lo_;
     float* const H = hi_;
     uint8_t* chp = choices_.get();
@@ -520,7 +451,7 @@ void IntervalEvaluator::eval(const Tape& t, const float* xlo, const float* xhi, 
             rh[i] = h[j];
         }
     };
-    for (const Instr& in : t.code) {
+    for (const Instr& in : std::span(t.code, t.len)) {
         float* rl = L + size_t(in.out) * kIvLanes;
         float* rh = H + size_t(in.out) * kIvLanes;
         const float* al = L + size_t(in.a) * kIvLanes;
@@ -540,7 +471,7 @@ void IntervalEvaluator::eval(const Tape& t, const float* xlo, const float* xhi, 
             std::fill_n(rl, m, time);                                                       \
             std::fill_n(rh, m, time);                                                       \
         } else {                                                                            \
-            if constexpr (choice_op<Op::name>()) {                                          \
+            if constexpr (is_choice_op(Op::name)) {                                         \
                 SDFC_IVDEP                                                                  \
                 for (int i = 0; i < m; ++i) {                                               \
                     uint8_t c;                                                              \
@@ -567,331 +498,6 @@ void IntervalEvaluator::eval(const Tape& t, const float* xlo, const float* xhi, 
 #undef OP
         }
     }
-}
-
-void simplify(const Tape& parent, const uint8_t* choices, int stride, int lane, Tape& out, SimplifyScratch& s) {
-    const size_t n = parent.code.size();
-    out.code.clear();
-    out.linked = false;
-    out.well_formed = false;
-    out.out = 0;
-    out.num_regs = 1;
-    out.choices = 0;
-    if (n == 0 || parent.out_def == Tape::kNone || !parent.linked) {
-        // The output is never written, or the tape reads unwritten registers: keep it as is.
-        out.code = parent.code;
-        out.out = parent.out;
-        out.num_regs = parent.num_regs;
-        out.choices = parent.choices;
-        return;
-    }
-    const size_t words = (n + 63) / 64;
-    s.live.assign(words, 0);
-    if (s.bind.size() < n) s.bind.resize(n);
-    if (s.free_regs.size() < n + 1) s.free_regs.resize(n + 1);
-    if (s.rev.size() < n + 1) s.rev.resize(n + 1);
-    Instr* rev = s.rev.data();
-    size_t nrev = 0;
-    uint16_t* free_regs = s.free_regs.data();
-    size_t nfree = 0;
-    uint16_t next = 0;
-    uint32_t nch = 0;
-    auto alloc = [&]() -> uint16_t { return nfree ? free_regs[--nfree] : next++; };
-    auto release = [&](uint16_t r) { free_regs[nfree++] = r; };
-    uint64_t* live = s.live.data();
-    uint16_t* bind = s.bind.data();
-    const uint8_t* cp = choices + lane;
-    const Instr* code = parent.code.data();
-    const Tape::Link* links = parent.links.data();
-    // A decided choice op whose winner is a register is skipped: its users read the winner
-    // directly (following chains of them).
-    auto chase = [&](uint32_t d) -> uint32_t {
-        for (;;) {
-            const uint32_t sl = links[d].slot;
-            if (sl == Tape::kNone) return d;
-            const uint8_t ch = cp[size_t(sl) * size_t(stride)];
-            if (ch == kChoiceBoth) return d;
-            if (ch == kChoiceB && (code[d].op == Op::MinI || code[d].op == Op::MaxI)) return d;  // becomes a Const
-            d = links[d].def[ch - 1];
-        }
-    };
-    {
-        const uint32_t o = chase(parent.out_def);
-        live[o >> 6] |= uint64_t(1) << (o & 63);
-        bind[o] = alloc();
-    }
-    // The register holding the value of instruction d, allocating one at its last use
-    // (the first met walking backwards).
-    auto use = [&](uint32_t d) -> uint16_t {
-        d = chase(d);
-        uint64_t& w = live[d >> 6];
-        const uint64_t bit = uint64_t(1) << (d & 63);
-        if (!(w & bit)) {
-            w |= bit;
-            bind[d] = alloc();
-        }
-        return bind[d];
-    };
-    for (size_t w = words; w-- > 0;) {
-        uint64_t word;
-        while ((word = live[w]) != 0) {
-            const int b = 63 - __builtin_clzll(word);
-            live[w] = word & ~(uint64_t(1) << b);
-            const uint32_t i = uint32_t(w * 64 + size_t(b));
-            const Instr in = code[i];
-            const Tape::Link& l = links[i];
-            const uint16_t X = bind[i];
-            release(X);  // before the operands: the result may reuse an operand's register
-            if (l.slot != Tape::kNone) {
-                if (cp[size_t(l.slot) * size_t(stride)] != kChoiceBoth) {
-                    // MinI/MaxI whose immediate wins (chase() stops there): a constant.
-                    Instr c{Op::Const};
-                    c.out = X;
-                    c.k = in.k;
-                    rev[nrev++] = c;
-                    continue;
-                }
-                ++nch;
-            }
-            Instr e{in.op};
-            e.out = X;
-            e.k = in.k;
-            // Operand a first: it gets the output's register when it dies here, so a later
-            // trace (simplify_batch) of this tape needs no copy when a wins a choice (the
-            // common case: the accumulated side of a min/max chain).
-            const int ar = kOpInfo[int(in.op)].arity;
-            if (ar >= 1) e.a = use(l.def[0]);
-            if (ar >= 2) e.b = use(l.def[1]);
-            if (ar >= 3) e.c = use(l.def[2]);
-            rev[nrev++] = e;
-        }
-    }
-    out.code.assign(std::make_reverse_iterator(rev + nrev), std::make_reverse_iterator(rev));
-    out.out = 0;  // the output was bound first
-    out.num_regs = std::max<uint32_t>(next, 1);
-    out.choices = nch;
-    out.well_formed = true;
-    out.link();  // ready to be simplified further
-}
-
-namespace {
-
-// Lanes (of the first 64) whose choice byte in `row` equals v.
-inline uint64_t lanes_equal(const uint8_t* row, uint8_t v) {
-#if defined(__SSE2__)
-    const __m128i want = _mm_set1_epi8(char(v));
-    uint64_t m = 0;
-    for (int q = 0; q < 4; ++q) {
-        __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + 16 * q));
-        m |= uint64_t(uint32_t(_mm_movemask_epi8(_mm_cmpeq_epi8(x, want)) & 0xFFFF)) << (16 * q);
-    }
-    return m;
-#else
-    uint64_t m = 0;
-    for (int i = 0; i < 64; ++i) m |= uint64_t(row[i] == v) << i;
-    return m;
-#endif
-}
-
-}  // namespace
-
-void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s,
-                    bool compact) {
-    const size_t n = parent.code.size();
-    s.len.fill(0);
-    s.out.fill(0);
-    s.cap = n;
-    if (lanes == 0) return;
-    const size_t blocks = size_t(64 - __builtin_clzll(lanes));  // lanes 0 .. the highest one used
-    if (s.buf_size < blocks * n) {
-        s.buf.reset(static_cast<Instr*>(::operator new(sizeof(Instr) * blocks * n)));
-        s.buf_size = blocks * n;
-    }
-    Instr* buf = s.buf.get();
-    if (!parent.linked || parent.out_def == Tape::kNone) {
-        for (uint64_t m = lanes; m; m &= m - 1) {
-            const int j = __builtin_ctzll(m);
-            std::copy(parent.code.begin(), parent.code.end(), buf + size_t(j) * n);
-            s.start[size_t(j)] = 0;
-            s.len[size_t(j)] = uint32_t(n);
-            s.regs[size_t(j)] = parent.num_regs;
-            s.out[size_t(j)] = parent.out;
-        }
-        return;
-    }
-    // Backwards: the lanes in which each instruction's value is needed.
-    if (s.mask.size() < n) s.mask.resize(n);
-    uint64_t* need = s.mask.data();
-    std::fill_n(need, n, uint64_t(0));
-    need[parent.out_def] = lanes;
-    const Instr* code = parent.code.data();
-    const Tape::Link* links = parent.links.data();
-    for (size_t i = n; i-- > 0;) {
-        const uint64_t m = need[i];
-        if (!m) continue;
-        const Instr& in = code[i];
-        const Tape::Link& l = links[i];
-        const int ar = kOpInfo[int(in.op)].arity;
-        if (l.slot == Tape::kNone) {
-            if (ar > 0) need[l.def[0]] |= m;
-            if (ar > 1) need[l.def[1]] |= m;
-            if (ar > 2) need[l.def[2]] |= m;
-            continue;
-        }
-        const uint8_t* row = choices + size_t(l.slot) * size_t(stride);
-        const uint64_t ca = lanes_equal(row, kChoiceA), cb = lanes_equal(row, kChoiceB);
-        const uint64_t cc = in.op == Op::Select ? lanes_equal(row, kChoiceC) : 0;
-        const uint64_t both = m & ~(ca | cb | cc);
-        need[l.def[0]] |= in.op == Op::Select ? both : (m & (ca | both));
-        if (in.op == Op::Min || in.op == Op::Max || in.op == Op::Select) need[l.def[1]] |= m & (cb | both);
-        if (in.op == Op::Select) need[l.def[2]] |= m & (cc | both);
-    }
-    if (!compact) {
-        // Forwards: each lane's instructions in the parent's registers. A decided choice op
-        // becomes a copy of the winner into its output register (nothing when the winner is
-        // already there) or, for an immediate, a constant.
-        std::array<uint32_t, 64> cnt{};
-        for (size_t i = 0; i < n; ++i) {
-            uint64_t m = need[i];
-            if (!m) continue;
-            const Instr in = code[i];
-            const uint32_t sl = links[i].slot;
-            if (sl == Tape::kNone) {
-                for (; m; m &= m - 1) {
-                    const size_t j = size_t(__builtin_ctzll(m));
-                    buf[j * n + cnt[j]++] = in;
-                }
-                continue;
-            }
-            const uint8_t* row = choices + size_t(sl) * size_t(stride);
-            for (; m; m &= m - 1) {
-                const size_t j = size_t(__builtin_ctzll(m));
-                const uint8_t ch = row[j];
-                if (ch == kChoiceBoth) {
-                    buf[j * n + cnt[j]++] = in;
-                    continue;
-                }
-                Instr c{Op::Copy};
-                c.out = in.out;
-                if (ch == kChoiceB && (in.op == Op::MinI || in.op == Op::MaxI)) {
-                    c.op = Op::Const;
-                    c.k = in.k;
-                } else {
-                    c.a = ch == kChoiceA ? in.a : (ch == kChoiceB ? in.b : in.c);
-                    if (c.a == c.out) continue;  // the winner is already in place
-                }
-                buf[j * n + cnt[j]++] = c;
-            }
-        }
-        for (uint64_t lm = lanes; lm; lm &= lm - 1) {
-            const size_t j = size_t(__builtin_ctzll(lm));
-            s.start[j] = 0;
-            s.len[j] = cnt[j];
-            s.regs[j] = parent.num_regs;
-            s.out[j] = parent.out;
-        }
-        return;
-    }
-    // Forwards: each lane's live instructions, as parent indices in order.
-    if (s.idx_size < blocks * n) {
-        s.idx.reset(new uint32_t[blocks * n]);
-        s.idx_size = blocks * n;
-    }
-    uint32_t* idx = s.idx.get();
-    std::array<uint32_t, 64> cnt{};
-    for (size_t i = 0; i < n; ++i)
-        for (uint64_t m = need[i]; m; m &= m - 1) {
-            const size_t j = size_t(__builtin_ctzll(m));
-            idx[j * n + cnt[j]++] = uint32_t(i);
-        }
-    // Per lane, backwards over its live instructions: registers re-allocated (linear scan;
-    // an op's output may share a dying operand's register, which the lane-wise VM allows);
-    // a decided choice op's winner takes over its output register (no instruction), or is
-    // copied when it stays needed elsewhere; an immediate that wins becomes a constant.
-    constexpr uint16_t kFree = 0xFFFF;
-    const size_t nregs = std::max<size_t>(parent.num_regs, size_t(parent.out) + 1);
-    if (s.bind.size() < nregs) s.bind.resize(nregs);
-    if (s.free_regs.size() < n + 1) s.free_regs.resize(n + 1);
-    uint16_t* bind = s.bind.data();
-    uint16_t* free_regs = s.free_regs.data();
-    for (uint64_t lm = lanes; lm; lm &= lm - 1) {
-        const size_t j = size_t(__builtin_ctzll(lm));
-        std::fill_n(bind, nregs, kFree);
-        size_t nfree = 0;
-        uint16_t next = 0;
-        auto alloc = [&]() -> uint16_t { return nfree ? free_regs[--nfree] : next++; };
-        Instr* out = buf + j * n + n;  // written backwards from the end of the lane's block
-        size_t nout = 0;
-        bind[parent.out] = alloc();
-        const uint32_t* list = idx + j * n;
-        for (size_t q = cnt[j]; q-- > 0;) {
-            const uint32_t i = list[q];
-            const Instr& in = code[i];
-            const uint16_t X = bind[in.out];
-            if (X == kFree) continue;  // (cannot happen: the lane needs every listed value)
-            bind[in.out] = kFree;
-            const uint32_t sl = links[i].slot;
-            const uint8_t ch = sl == Tape::kNone ? uint8_t(kChoiceBoth) : choices[size_t(sl) * size_t(stride) + j];
-            if (ch != kChoiceBoth) {
-                if (ch == kChoiceB && (in.op == Op::MinI || in.op == Op::MaxI)) {
-                    Instr c{Op::Const};
-                    c.out = X;
-                    c.k = in.k;
-                    *--out = c;
-                    ++nout;
-                    free_regs[nfree++] = X;
-                    continue;
-                }
-                const uint16_t w = ch == kChoiceA ? in.a : (ch == kChoiceB ? in.b : in.c);
-                if (bind[w] == kFree) {
-                    bind[w] = X;  // the winner's value lives in X: no instruction
-                } else {
-                    Instr c{Op::Copy};
-                    c.out = X;
-                    c.a = bind[w];
-                    *--out = c;
-                    ++nout;
-                    free_regs[nfree++] = X;
-                }
-                continue;
-            }
-            free_regs[nfree++] = X;  // before the operands: the result may reuse one's register
-            Instr e{in.op};
-            e.out = X;
-            e.k = in.k;
-            {
-                // Operand a first: it gets the output's register when it dies here (see simplify()).
-                const int ar = kOpInfo[int(in.op)].arity;
-                if (ar >= 1) {
-                    if (bind[in.a] == kFree) bind[in.a] = alloc();
-                    e.a = bind[in.a];
-                }
-                if (ar >= 2) {
-                    if (bind[in.b] == kFree) bind[in.b] = alloc();
-                    e.b = bind[in.b];
-                }
-                if (ar >= 3) {
-                    if (bind[in.c] == kFree) bind[in.c] = alloc();
-                    e.c = bind[in.c];
-                }
-            }
-            *--out = e;
-            ++nout;
-        }
-        s.start[j] = uint32_t(n - nout);
-        s.len[j] = uint32_t(nout);
-        s.regs[j] = std::max<uint32_t>(next, 1);
-    }
-}
-
-void Tape::assign(const Instr* c, size_t count, uint16_t out_reg, uint32_t regs) {
-    code.assign(c, c + count);
-    out = out_reg;
-    num_regs = regs;
-    linked = false;
-    well_formed = true;  // simplify_batch's output
-    links.clear();
-    out_def = kNone;
 }
 
 }  // namespace sdfc

@@ -5,6 +5,8 @@
 #include <cstring>
 #include <new>
 
+#include "runtime/eval/simd.hpp"
+
 namespace sdfc {
 namespace {
 void free_aligned(float* p) { std::free(p); }
@@ -21,22 +23,19 @@ float* alloc_regs(size_t count) {
 constexpr int kGroup = 8;
 static_assert(kBatch % kGroup == 0);
 
-// The output register may be one of the operand registers (codegen reuses a dying
-// operand's register), but only lane i is ever read to write lane i, so the loops carry no
-// dependence; tell the vectoriser so it neither versions nor falls back to scalar code.
-#if defined(__clang__)
-#define SDFC_IVDEP _Pragma("clang loop vectorize(assume_safety)")
-#elif defined(__GNUC__)
-#define SDFC_IVDEP _Pragma("GCC ivdep")
-#else
-#define SDFC_IVDEP
-#endif
 }  // namespace
 
-Evaluator::Evaluator(const Program& program)
-    : program_(&program),
-      storage_(alloc_regs(static_cast<size_t>(program.num_regs) * kBatch), &free_aligned),
+BatchVM::BatchVM(uint32_t max_regs)
+    : max_regs_(std::max<uint32_t>(max_regs, 1)),
+      storage_(alloc_regs(static_cast<size_t>(max_regs_) * kBatch), &free_aligned),
       regs_(storage_.get()) {}
+
+void BatchVM::reserve(uint32_t regs) {
+    if (regs <= max_regs_) return;
+    storage_.reset(alloc_regs(static_cast<size_t>(regs) * kBatch));
+    regs_ = storage_.get();
+    max_regs_ = regs;
+}
 
 // One pass over the program with the lane count M known at compile time when FULL (the
 // loops unroll completely) or given at run time (m, a multiple of kGroup) otherwise.
@@ -102,22 +101,13 @@ static inline void run(const Instr* code, const Instr* end, float* base, const f
 #undef SDFC_CASE
 }
 
-void Evaluator::eval(const float* x, const float* y, const float* z, int n, float time) {
-    eval_code(program_->code.data(), program_->code.size(), x, y, z, n, time);
-}
-
-void Evaluator::eval_code(const Instr* code, size_t count, const float* x, const float* y, const float* z, int n,
-                          float time) {
+void BatchVM::eval(const TapeView& t, const float* x, const float* y, const float* z, int n, float time) {
     if (n <= 0) return;
+    if (t.num_regs > max_regs_) reserve(t.num_regs);
     const int m = (n + kGroup - 1) / kGroup * kGroup;  // lanes computed
-    const Instr* end = code + count;
-    if (m == kBatch) run<true>(code, end, regs_, x, y, z, n, m, time);
-    else run<false>(code, end, regs_, x, y, z, n, m, time);
-}
-
-float Evaluator::eval1(float x, float y, float z, float time) {
-    eval(&x, &y, &z, 1, time);
-    return output(0)[0];
+    const Instr* end = t.code + t.len;
+    if (m == kBatch) run<true>(t.code, end, regs_, x, y, z, n, m, time);
+    else run<false>(t.code, end, regs_, x, y, z, n, m, time);
 }
 
 }  // namespace sdfc

@@ -1,6 +1,7 @@
-// The batch VM: evaluates a Program on up to kBatch points at once, structure of arrays,
-// one switch per instruction and a tight loop over the lanes (which the compiler
-// vectorises). No allocation after construction; one Evaluator per thread.
+// The batch VM: evaluates a tape on up to kBatch points at once, structure of arrays, one
+// switch per instruction and a tight loop over the lanes (which the compiler vectorises).
+// The VM owns only its register file; the tape is an argument of eval (a TapeView of a
+// Program, an interval Tape or a simplified leaf), so one VM per thread runs every tape.
 #pragma once
 #include <cstddef>
 #include <memory>
@@ -12,34 +13,59 @@ namespace sdfc {
 
 inline constexpr int kBatch = 64;
 
-class Evaluator {
+class BatchVM {
 public:
-    explicit Evaluator(const Program& program);
-    Evaluator(const Evaluator&) = delete;
-    Evaluator& operator=(const Evaluator&) = delete;
+    explicit BatchVM(uint32_t max_regs);
+    BatchVM(const BatchVM&) = delete;
+    BatchVM& operator=(const BatchVM&) = delete;
 
-    // Evaluates n <= kBatch points; results readable through output(i) until the next call.
-    void eval(const float* x, const float* y, const float* z, int n, float time = 0.0f);
-    const float* output(int i) const { return reg(program_->outputs[static_cast<size_t>(i)]); }
-
-    // Runs `count` instructions of another tape (e.g. a simplified one, runtime/eval/interval.hpp)
-    // on this register file; it must use at most program().num_regs registers. Read the
-    // result with reg_data(its output register).
-    void eval_code(const Instr* code, size_t count, const float* x, const float* y, const float* z, int n,
-                   float time = 0.0f);
+    // Evaluates n <= kBatch points; results readable through output(t, i) or reg_data until
+    // the next call. A tape needing more than max_regs() registers grows the register file
+    // (the only allocation after construction); one with num_regs 0 must fit.
+    void eval(const TapeView& t, const float* x, const float* y, const float* z, int n, float time = 0.0f);
+    const float* output(const TapeView& t, uint32_t i = 0) const { return reg(t.output(i)); }
     const float* reg_data(uint32_t r) const { return reg(r); }
-
-    // Convenience: one point, first output.
-    float eval1(float x, float y, float z, float time = 0.0f);
-
-    const Program& program() const { return *program_; }
+    uint32_t max_regs() const { return max_regs_; }
+    void reserve(uint32_t regs);  // register file of at least `regs` registers
 
 private:
     float* reg(uint32_t r) { return regs_ + static_cast<size_t>(r) * kBatch; }
     const float* reg(uint32_t r) const { return regs_ + static_cast<size_t>(r) * kBatch; }
-    const Program* program_;
+    uint32_t max_regs_ = 0;
     std::unique_ptr<float[], void (*)(float*)> storage_;
-    float* regs_;
+    float* regs_ = nullptr;
+};
+
+// A BatchVM bound to one Program: the older interface (eval without a tape, output(i)).
+class Evaluator : public BatchVM {
+public:
+    explicit Evaluator(const Program& program) : BatchVM(program.num_regs), program_(&program) {}
+
+    using BatchVM::eval;
+    using BatchVM::output;
+    void eval(const float* x, const float* y, const float* z, int n, float time = 0.0f) {
+        BatchVM::eval(program_->view(), x, y, z, n, time);
+    }
+    const float* output(int i) const { return reg_data(program_->outputs[static_cast<size_t>(i)]); }
+
+    // Runs `count` instructions of another tape on this register file (they must use at
+    // most max_regs() registers); read the result with reg_data(its output register).
+    // Prefer eval(TapeView).
+    void eval_code(const Instr* code, size_t count, const float* x, const float* y, const float* z, int n,
+                   float time = 0.0f) {
+        BatchVM::eval(TapeView{code, static_cast<uint32_t>(count)}, x, y, z, n, time);
+    }
+
+    // Convenience: one point, first output.
+    float eval1(float x, float y, float z, float time = 0.0f) {
+        eval(&x, &y, &z, 1, time);
+        return output(0)[0];
+    }
+
+    const Program& program() const { return *program_; }
+
+private:
+    const Program* program_;
 };
 
 }  // namespace sdfc

@@ -40,6 +40,7 @@ TEST_CASE("simplified tapes compute the same floats as the full tape inside thei
     IntervalEvaluator iv(full.num_regs, full.choices);
     SimplifyScratch ss;
     Evaluator ev(prog);
+    BatchVM vm(1);  // grows to the tapes it runs
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(-1.2f, 1.2f), sz(0.01f, 0.6f);
     size_t shorter = 0;
@@ -65,9 +66,9 @@ TEST_CASE("simplified tapes compute the same floats as the full tape inside thei
             float want[kBatch];
             for (int i = 0; i < kBatch; ++i) want[i] = ev.output(0)[i];
             const Interval r = iv.result(l);
-            ev.eval_code(t.code.data(), t.code.size(), xs, ys, zs, kBatch);
+            vm.eval(t.view(), xs, ys, zs, kBatch);
             for (int i = 0; i < kBatch; ++i) {
-                REQUIRE(std::bit_cast<uint32_t>(ev.reg_data(t.out)[i]) == std::bit_cast<uint32_t>(want[i]));
+                REQUIRE(std::bit_cast<uint32_t>(vm.output(t.view())[i]) == std::bit_cast<uint32_t>(want[i]));
                 REQUIRE(inside(want[i], r));
             }
         }
@@ -89,6 +90,7 @@ TEST_CASE("simplify_batch: compact tapes and traces compute the full tape's floa
     IntervalEvaluator iv(full.num_regs, full.choices), iv2(full.num_regs, full.choices);
     BatchScratch bs, bs2;
     Evaluator ev(prog);
+    BatchVM vm(1);  // runs the children through their views (and grows to fit them)
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(-1.2f, 1.2f), sz(0.01f, 0.8f);
     size_t shorter = 0;
@@ -114,9 +116,9 @@ TEST_CASE("simplify_batch: compact tapes and traces compute the full tape's floa
                 ev.eval(xs, ys, zs, kBatch);
                 float want[kBatch];
                 for (int i = 0; i < kBatch; ++i) want[i] = ev.output(0)[i];
-                ev.eval_code(bs.code(l), bs.len[size_t(l)], xs, ys, zs, kBatch);
+                vm.eval(bs.view(l), xs, ys, zs, kBatch);
                 for (int i = 0; i < kBatch; ++i)
-                    REQUIRE(std::bit_cast<uint32_t>(ev.reg_data(bs.out[size_t(l)])[i]) == std::bit_cast<uint32_t>(want[i]));
+                    REQUIRE(std::bit_cast<uint32_t>(vm.output(bs.view(l))[i]) == std::bit_cast<uint32_t>(want[i]));
                 if (!compact || l % 9 != 0) continue;
                 // A compact child simplifies further, over sub-boxes of its box.
                 Tape child;
@@ -138,9 +140,9 @@ TEST_CASE("simplify_batch: compact tapes and traces compute the full tape's floa
                     }
                     ev.eval(xs, ys, zs, kBatch);
                     for (int i = 0; i < kBatch; ++i) want[i] = ev.output(0)[i];
-                    ev.eval_code(bs2.code(k), bs2.len[size_t(k)], xs, ys, zs, kBatch);
+                    vm.eval(bs2.view(k), xs, ys, zs, kBatch);
                     for (int i = 0; i < kBatch; ++i)
-                        REQUIRE(std::bit_cast<uint32_t>(ev.reg_data(bs2.out[size_t(k)])[i]) == std::bit_cast<uint32_t>(want[i]));
+                        REQUIRE(std::bit_cast<uint32_t>(vm.output(bs2.view(k))[i]) == std::bit_cast<uint32_t>(want[i]));
                 }
             }
         }

@@ -1,0 +1,297 @@
+// Tape simplification (see simplify.hpp): one box at a time (simplify) or many at once
+// (simplify_batch). Registers are re-allocated backwards from the output with the shared
+// policy of compiler/bytecode/regalloc.hpp.
+#include "runtime/eval/simplify.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include <algorithm>
+#include <iterator>
+
+#include "compiler/bytecode/regalloc.hpp"
+
+namespace sdfc {
+
+void simplify(const Tape& parent, const uint8_t* choices, int stride, int lane, Tape& out, SimplifyScratch& s) {
+    const size_t n = parent.code.size();
+    out.code.clear();
+    out.linked = false;
+    out.well_formed = false;
+    out.out = 0;
+    out.num_regs = 1;
+    out.choices = 0;
+    if (n == 0 || parent.out_def == Tape::kNone || !parent.linked) {
+        // The output is never written, or the tape reads unwritten registers: keep it as is.
+        out.code = parent.code;
+        out.out = parent.out;
+        out.num_regs = parent.num_regs;
+        out.choices = parent.choices;
+        return;
+    }
+    const size_t words = (n + 63) / 64;
+    s.live.assign(words, 0);
+    if (s.bind.size() < n) s.bind.resize(n);
+    if (s.rev.size() < n + 1) s.rev.resize(n + 1);
+    Instr* rev = s.rev.data();
+    size_t nrev = 0;
+    RegPool pool(s.free_regs, n + 1);
+    uint32_t nch = 0;
+    uint64_t* live = s.live.data();
+    uint16_t* bind = s.bind.data();
+    const uint8_t* cp = choices + lane;
+    const Instr* code = parent.code.data();
+    const Tape::Link* links = parent.links.data();
+    // A decided choice op whose winner is a register is skipped: its users read the winner
+    // directly (following chains of them).
+    auto chase = [&](uint32_t d) -> uint32_t {
+        for (;;) {
+            const uint32_t sl = links[d].slot;
+            if (sl == Tape::kNone) return d;
+            const uint8_t ch = cp[size_t(sl) * size_t(stride)];
+            if (ch == kChoiceBoth) return d;
+            if (ch == kChoiceB && (code[d].op == Op::MinI || code[d].op == Op::MaxI)) return d;  // becomes a Const
+            d = links[d].def[ch - 1];
+        }
+    };
+    {
+        const uint32_t o = chase(parent.out_def);
+        live[o >> 6] |= uint64_t(1) << (o & 63);
+        bind[o] = pool.alloc();
+    }
+    // The register holding the value of instruction d, allocating one at its last use
+    // (the first met walking backwards).
+    auto use = [&](uint32_t d) -> uint16_t {
+        d = chase(d);
+        uint64_t& w = live[d >> 6];
+        const uint64_t bit = uint64_t(1) << (d & 63);
+        if (!(w & bit)) {
+            w |= bit;
+            bind[d] = pool.alloc();
+        }
+        return bind[d];
+    };
+    for (size_t w = words; w-- > 0;) {
+        uint64_t word;
+        while ((word = live[w]) != 0) {
+            const int b = 63 - __builtin_clzll(word);
+            live[w] = word & ~(uint64_t(1) << b);
+            const uint32_t i = uint32_t(w * 64 + size_t(b));
+            const Instr in = code[i];
+            const Tape::Link& l = links[i];
+            const uint16_t X = bind[i];
+            if (l.slot != Tape::kNone) {
+                if (cp[size_t(l.slot) * size_t(stride)] != kChoiceBoth) {
+                    // MinI/MaxI whose immediate wins (chase() stops there): a constant.
+                    pool.release(X);
+                    Instr c{Op::Const};
+                    c.out = X;
+                    c.k = in.k;
+                    rev[nrev++] = c;
+                    continue;
+                }
+                ++nch;
+            }
+            rev[nrev++] = emit_backward(pool, in, X, [&](int j) { return use(l.def[j]); });
+        }
+    }
+    out.code.assign(std::make_reverse_iterator(rev + nrev), std::make_reverse_iterator(rev));
+    out.out = 0;  // the output was bound first
+    out.num_regs = pool.used();
+    out.choices = nch;
+    out.well_formed = true;
+    out.link();  // ready to be simplified further
+}
+
+namespace {
+
+// Lanes (of the first 64) whose choice byte in `row` equals v.
+inline uint64_t lanes_equal(const uint8_t* row, uint8_t v) {
+#if defined(__SSE2__)
+    const __m128i want = _mm_set1_epi8(char(v));
+    uint64_t m = 0;
+    for (int q = 0; q < 4; ++q) {
+        __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + 16 * q));
+        m |= uint64_t(uint32_t(_mm_movemask_epi8(_mm_cmpeq_epi8(x, want)) & 0xFFFF)) << (16 * q);
+    }
+    return m;
+#else
+    uint64_t m = 0;
+    for (int i = 0; i < 64; ++i) m |= uint64_t(row[i] == v) << i;
+    return m;
+#endif
+}
+
+}  // namespace
+
+void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s,
+                    bool compact) {
+    const size_t n = parent.code.size();
+    s.len.fill(0);
+    s.out.fill(0);
+    s.cap = n;
+    if (lanes == 0) return;
+    const size_t blocks = size_t(64 - __builtin_clzll(lanes));  // lanes 0 .. the highest one used
+    if (s.buf_size < blocks * n) {
+        s.buf.reset(static_cast<Instr*>(::operator new(sizeof(Instr) * blocks * n)));
+        s.buf_size = blocks * n;
+    }
+    Instr* buf = s.buf.get();
+    if (!parent.linked || parent.out_def == Tape::kNone) {
+        for (uint64_t m = lanes; m; m &= m - 1) {
+            const int j = __builtin_ctzll(m);
+            std::copy(parent.code.begin(), parent.code.end(), buf + size_t(j) * n);
+            s.start[size_t(j)] = 0;
+            s.len[size_t(j)] = uint32_t(n);
+            s.regs[size_t(j)] = parent.num_regs;
+            s.out[size_t(j)] = parent.out;
+        }
+        return;
+    }
+    // Backwards: the lanes in which each instruction's value is needed.
+    if (s.mask.size() < n) s.mask.resize(n);
+    uint64_t* need = s.mask.data();
+    std::fill_n(need, n, uint64_t(0));
+    need[parent.out_def] = lanes;
+    const Instr* code = parent.code.data();
+    const Tape::Link* links = parent.links.data();
+    for (size_t i = n; i-- > 0;) {
+        const uint64_t m = need[i];
+        if (!m) continue;
+        const Instr& in = code[i];
+        const Tape::Link& l = links[i];
+        const int ar = kOpInfo[int(in.op)].arity;
+        if (l.slot == Tape::kNone) {
+            if (ar > 0) need[l.def[0]] |= m;
+            if (ar > 1) need[l.def[1]] |= m;
+            if (ar > 2) need[l.def[2]] |= m;
+            continue;
+        }
+        const uint8_t* row = choices + size_t(l.slot) * size_t(stride);
+        const uint64_t ca = lanes_equal(row, kChoiceA), cb = lanes_equal(row, kChoiceB);
+        const uint64_t cc = in.op == Op::Select ? lanes_equal(row, kChoiceC) : 0;
+        const uint64_t both = m & ~(ca | cb | cc);
+        need[l.def[0]] |= in.op == Op::Select ? both : (m & (ca | both));
+        if (in.op == Op::Min || in.op == Op::Max || in.op == Op::Select) need[l.def[1]] |= m & (cb | both);
+        if (in.op == Op::Select) need[l.def[2]] |= m & (cc | both);
+    }
+    if (!compact) {
+        // Forwards: each lane's instructions in the parent's registers. A decided choice op
+        // becomes a copy of the winner into its output register (nothing when the winner is
+        // already there) or, for an immediate, a constant.
+        std::array<uint32_t, 64> cnt{};
+        for (size_t i = 0; i < n; ++i) {
+            uint64_t m = need[i];
+            if (!m) continue;
+            const Instr in = code[i];
+            const uint32_t sl = links[i].slot;
+            if (sl == Tape::kNone) {
+                for (; m; m &= m - 1) {
+                    const size_t j = size_t(__builtin_ctzll(m));
+                    buf[j * n + cnt[j]++] = in;
+                }
+                continue;
+            }
+            const uint8_t* row = choices + size_t(sl) * size_t(stride);
+            for (; m; m &= m - 1) {
+                const size_t j = size_t(__builtin_ctzll(m));
+                const uint8_t ch = row[j];
+                if (ch == kChoiceBoth) {
+                    buf[j * n + cnt[j]++] = in;
+                    continue;
+                }
+                Instr c{Op::Copy};
+                c.out = in.out;
+                if (ch == kChoiceB && (in.op == Op::MinI || in.op == Op::MaxI)) {
+                    c.op = Op::Const;
+                    c.k = in.k;
+                } else {
+                    c.a = ch == kChoiceA ? in.a : (ch == kChoiceB ? in.b : in.c);
+                    if (c.a == c.out) continue;  // the winner is already in place
+                }
+                buf[j * n + cnt[j]++] = c;
+            }
+        }
+        for (uint64_t lm = lanes; lm; lm &= lm - 1) {
+            const size_t j = size_t(__builtin_ctzll(lm));
+            s.start[j] = 0;
+            s.len[j] = cnt[j];
+            s.regs[j] = parent.num_regs;
+            s.out[j] = parent.out;
+        }
+        return;
+    }
+    // Forwards: each lane's live instructions, as parent indices in order.
+    if (s.idx_size < blocks * n) {
+        s.idx.reset(new uint32_t[blocks * n]);
+        s.idx_size = blocks * n;
+    }
+    uint32_t* idx = s.idx.get();
+    std::array<uint32_t, 64> cnt{};
+    for (size_t i = 0; i < n; ++i)
+        for (uint64_t m = need[i]; m; m &= m - 1) {
+            const size_t j = size_t(__builtin_ctzll(m));
+            idx[j * n + cnt[j]++] = uint32_t(i);
+        }
+    // Per lane, backwards over its live instructions: registers re-allocated (linear scan;
+    // an op's output may share a dying operand's register, which the lane-wise VM allows);
+    // a decided choice op's winner takes over its output register (no instruction), or is
+    // copied when it stays needed elsewhere; an immediate that wins becomes a constant.
+    constexpr uint16_t kFree = 0xFFFF;
+    const size_t nregs = std::max<size_t>(parent.num_regs, size_t(parent.out) + 1);
+    if (s.bind.size() < nregs) s.bind.resize(nregs);
+    uint16_t* bind = s.bind.data();
+    for (uint64_t lm = lanes; lm; lm &= lm - 1) {
+        const size_t j = size_t(__builtin_ctzll(lm));
+        std::fill_n(bind, nregs, kFree);
+        RegPool pool(s.free_regs, n + 1);
+        Instr* out = buf + j * n + n;  // written backwards from the end of the lane's block
+        size_t nout = 0;
+        bind[parent.out] = pool.alloc();
+        const uint32_t* list = idx + j * n;
+        for (size_t q = cnt[j]; q-- > 0;) {
+            const uint32_t i = list[q];
+            const Instr& in = code[i];
+            const uint16_t X = bind[in.out];
+            if (X == kFree) continue;  // (cannot happen: the lane needs every listed value)
+            bind[in.out] = kFree;
+            const uint32_t sl = links[i].slot;
+            const uint8_t ch = sl == Tape::kNone ? uint8_t(kChoiceBoth) : choices[size_t(sl) * size_t(stride) + j];
+            if (ch != kChoiceBoth) {
+                if (ch == kChoiceB && (in.op == Op::MinI || in.op == Op::MaxI)) {
+                    Instr c{Op::Const};
+                    c.out = X;
+                    c.k = in.k;
+                    *--out = c;
+                    ++nout;
+                    pool.release(X);
+                    continue;
+                }
+                const uint16_t w = ch == kChoiceA ? in.a : (ch == kChoiceB ? in.b : in.c);
+                if (bind[w] == kFree) {
+                    bind[w] = X;  // the winner's value lives in X: no instruction
+                } else {
+                    Instr c{Op::Copy};
+                    c.out = X;
+                    c.a = bind[w];
+                    *--out = c;
+                    ++nout;
+                    pool.release(X);
+                }
+                continue;
+            }
+            *--out = emit_backward(pool, in, X, [&](int op) {
+                const uint16_t r = op == 0 ? in.a : (op == 1 ? in.b : in.c);
+                if (bind[r] == kFree) bind[r] = pool.alloc();
+                return bind[r];
+            });
+            ++nout;
+        }
+        s.start[j] = uint32_t(n - nout);
+        s.len[j] = uint32_t(nout);
+        s.regs[j] = pool.used();
+    }
+}
+
+}  // namespace sdfc

@@ -1,0 +1,59 @@
+// The tape of the interval evaluator and of tape simplification: one output of a Program,
+// or a shortened copy of one, plus the def links simplify() follows (runtime/eval/simplify.hpp).
+// Choice ops (min, max, select) are the ops whose winning side an interval can decide.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "compiler/bytecode/program.hpp"
+
+namespace sdfc {
+
+// Which side an op takes over a whole box (Min, Max, MinI, MaxI, Select).
+enum : uint8_t {
+    kChoiceBoth = 0,  // undecided: keep the op
+    kChoiceA = 1,     // operand a
+    kChoiceB = 2,     // operand b (MinI/MaxI: the immediate k)
+    kChoiceC = 3,     // operand c (Select)
+};
+// A bit test, not a chain of compares: link() asks it for every instruction, and the
+// branches of a chain mispredict on mixed code (measured: link() took twice as long).
+inline constexpr uint64_t kChoiceOps = (uint64_t(1) << int(Op::Min)) | (uint64_t(1) << int(Op::Max)) |
+                                       (uint64_t(1) << int(Op::MinI)) | (uint64_t(1) << int(Op::MaxI)) |
+                                       (uint64_t(1) << int(Op::Select));
+static_assert(kOpCount <= 64);
+constexpr bool is_choice_op(Op op) { return (kChoiceOps >> int(op)) & 1; }
+
+// A straight-line program with one output: a Program's output, or a shortened copy.
+// link() adds what simplify() needs to visit only the live part of a tape: for every
+// operand the index of the instruction that defined its value (registers are reused, so
+// this is the last earlier write of the register), and each choice op's slot.
+struct Tape {
+    static constexpr uint32_t kNone = 0xFFFFFFFFu;
+    std::vector<Instr> code;
+    uint16_t out = 0;        // output register
+    uint32_t num_regs = 1;   // registers used (a VM register file this big suffices)
+    uint32_t choices = 0;    // instructions with is_choice_op, in order: their "slots"
+    // link(): per instruction, the instructions defining its operands a, b, c (kNone: unused)
+    // and its choice slot (kNone: not a choice op).
+    struct Link {
+        uint32_t def[3];
+        uint32_t slot;
+    };
+    std::vector<Link> links;
+    uint32_t out_def = kNone;    // the instruction defining the output
+    bool linked = false;
+    bool well_formed = false;    // known: every operand is written before it is read (simplify's output)
+
+    static Tape from(const Program& p, int output = 0);
+    void assign(const Instr* code, size_t count, uint16_t out_reg, uint32_t regs);  // a child of simplify_batch
+    void recount();  // sets num_regs and choices from code
+    void link();     // fills links and out_def
+
+    // (choices is only sure once linked: assign() leaves it stale)
+    TapeView view() const {
+        return {code.data(), uint32_t(code.size()), &out, 1, num_regs, linked ? choices : TapeView::kUncounted};
+    }
+};
+
+}  // namespace sdfc
