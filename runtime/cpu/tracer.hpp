@@ -5,7 +5,7 @@
 // tile are marched together through a 64-lane window that is refilled as rays finish, then
 // normals (tetrahedron, 4 evals per hit), materials, shadow rays, AO taps and secondary
 // rays are evaluated in batches too. A tile's result depends only on the tile, so the
-// image is bit-identical for any thread count. See tracer.cpp for the shading model.
+// image is bit-identical for any thread count.
 //
 // Acceleration (all off with RenderOptions::baseline): before the tiles, a "tape tree" is
 // built once per frame: an octree over the scene whose cells carry the distance program
@@ -13,6 +13,17 @@
 // Every distance evaluation (camera, shadow, secondary rays, normals, AO) runs the tape of
 // the leaf cell containing its point, and rays jump over cells the interval proves empty.
 // Plus over-relaxed sphere tracing and clipping to the scene's bounding box.
+//
+// The files, each with its part of the design in its opening comment:
+//   tracer.cpp     render(): frame, AOV planes, tape tree, tile scheduling, stats
+//   frame.*        Frame, what the workers share: settings resolved once, clipping, samples
+//   tape_tree.*    the tape tree and its build
+//   worker.hpp     Worker, one thread's tracer and scratch; rays.hpp, lanes.hpp its batches
+//   marcher.cpp    the lane-window loop and the marches (camera, cone, raw, shadows)
+//   shade.cpp      normals, materials, lights, ambient occlusion, bounces
+//   tile.cpp       one tile: primary rays, generations, pixels and AOVs
+// 2D models (CompiledScene::is_2d) are not traced: render() returns raster2d's render_2d
+// image (slice.hpp).
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -71,6 +82,9 @@ const std::vector<std::string>& known_aovs();
 
 // Renders scene.render.width x scene.render.height pixels. Throws std::invalid_argument for
 // an unknown AOV name. `stats`, when given, receives the evaluation counts.
+// A 2D model gives render_2d's one-channel image (white where the field is < 0, options.
+// threads and baseline passed on, progress reported once as 1 of 1 tiles, stats: distance
+// points only); asking it for any AOV throws std::invalid_argument.
 Image render(const CompiledScene& scene, const RenderOptions& options, RenderStats* stats = nullptr);
 
 }  // namespace sdfc

@@ -17,6 +17,7 @@
 #include "compiler/bytecode/compile.hpp"
 #include "compiler/render/camera.hpp"
 #include "runtime/io/image.hpp"
+#include "runtime/cpu/slice.hpp"
 #include "runtime/cpu/tracer.hpp"
 
 using namespace sdfc;
@@ -337,10 +338,15 @@ TEST_CASE("render: 2D models render as the Prospero image", "[render][2d]") {
     CompiledScene s = b.compile(disc, b.material({1, 1, 1}), 33, 33);
     s.is_2d = true;
     Image img = render(s, {});
-    CHECK(px(img, 16, 16) == glm::vec3(1));  // (0, 0) inside
-    CHECK(px(img, 0, 0) == glm::vec3(0));    // (-1, 1) outside
-    CHECK(px(img, 16, 9) == glm::vec3(1));   // row 9: y = 1 - 9/16 = 0.4375, inside
-    CHECK(px(img, 16, 7) == glm::vec3(0));   // row 7: y = 0.5625, outside
+    REQUIRE(img.channels == 1);  // render_2d's image, as `sdfc render` writes it
+    CHECK(img.at(16, 16, 0) == 1.0f);  // (0, 0) inside
+    CHECK(img.at(0, 0, 0) == 0.0f);    // (-1, 1) outside
+    CHECK(img.at(16, 9, 0) == 1.0f);   // row 9: y = 1 - 9/16 = 0.4375, inside
+    CHECK(img.at(16, 7, 0) == 0.0f);   // row 7: y = 0.5625, outside
+    CHECK(img.pixels == render_2d(s, 33, 33).pixels);
+    RenderOptions o;
+    o.aovs = {"depth"};
+    CHECK_THROWS_AS(render(s, o), std::invalid_argument);
 }
 
 TEST_CASE("image: png round trip, sRGB encoded", "[image]") {

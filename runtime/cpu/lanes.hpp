@@ -1,0 +1,120 @@
+// The lane window of a Worker's march (marcher.cpp): up to kWindow rays in flight,
+// structure of arrays so that the per-step work (point gather, the distance update)
+// vectorises, and Buckets, which group the lanes by tape-tree leaf for evaluation.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "runtime/cpu/rays.hpp"
+#include "runtime/cpu/tape_tree.hpp"
+#include "runtime/eval/vm.hpp"
+
+namespace sdfc::cpu {
+
+constexpr int kWindow = 128;  // rays in flight per worker (a multiple of kBatch)
+static_assert(kWindow % kBatch == 0);
+
+// Finished lanes are refilled with the last lane (swap-remove) and then from the queue.
+// With a tape tree, each lane caches the leaf holding its point (box and interval), and
+// lanes are evaluated grouped by leaf.
+//
+// Every march keeps its own per-lane state in the six slots a, b, w, om, pr, sl (plain
+// floats, so that loading and moving a lane stays one fixed set of copies):
+//
+//   march         a = last signed distance (inf after a failed relaxed step)
+//                 om, pr, sl = over-relaxation: factor omega, previous radius |d|, last step
+//   shadow_hard   a = last distance;  om, pr, sl as march
+//   shadow_soft   a = res, the smallest cone fraction so far;  b = previous positive
+//                 distance (1e20: none);  w = the light's width (tangent) from the ray;
+//                 om, pr, sl as march
+//   cone_march    a = smallest d / r in the current edge zone (>= 1: none);  b = its t;
+//                 w = 1 when the ray ended as a hit
+//   march_raw     a = previous t (< 0: none yet);  b, w = bisection bracket (outside end,
+//                 inside end);  sl = bisection iterations (0 while marching);
+//                 om = 1 when the ray ended as a hit
+//
+// `sign` is +1 for a ray outside solids, -1 inside (it marches on -d).
+struct Lanes {
+    alignas(64) float ox[kWindow], oy[kWindow], oz[kWindow], dx[kWindow], dy[kWindow], dz[kWindow];
+    alignas(64) float t[kWindow], tmax[kWindow], t0[kWindow], sign[kWindow], w[kWindow], a[kWindow], b[kWindow];
+    alignas(64) float om[kWindow], pr[kWindow], sl[kWindow];
+    alignas(64) float x[kWindow], y[kWindow], z[kWindow], dist[kWindow];
+    alignas(64) float blo[3][kWindow], bhi[3][kWindow], ivlo[kWindow], ivhi[kWindow];  // the lane's leaf
+    alignas(64) int32_t steps[kWindow], done[kWindow], idx[kWindow];
+    alignas(64) uint32_t ray[kWindow], leaf[kWindow];
+    void load(int i, const RaySet& rs, uint32_t r, float relax) {
+        ox[i] = rs.ox[r], oy[i] = rs.oy[r], oz[i] = rs.oz[r];
+        dx[i] = rs.dx[r], dy[i] = rs.dy[r], dz[i] = rs.dz[r];
+        t[i] = rs.tmin[r], tmax[i] = rs.tmax[r], t0[i] = rs.t0[r];
+        sign[i] = rs.inside[r] ? -1.0f : 1.0f;
+        w[i] = 0.0f, a[i] = 0.0f, b[i] = 0.0f;
+        om[i] = relax, pr[i] = 0.0f, sl[i] = 0.0f;
+        steps[i] = 0, done[i] = 0;
+        ray[i] = r;
+        for (int k = 0; k < 3; ++k) blo[k][i] = INFINITY, bhi[k][i] = -INFINITY;  // no leaf yet
+        leaf[i] = 0, ivlo[i] = -INFINITY, ivhi[i] = INFINITY;
+    }
+    void set_leaf(int i, uint32_t id, const TapeTree::Leaf& L) {
+        leaf[i] = id;
+        for (int k = 0; k < 3; ++k) blo[k][i] = L.lo[k], bhi[k][i] = L.hi[k];
+        ivlo[i] = L.ivlo, ivhi[i] = L.ivhi;
+    }
+    void move(int from, int to) {
+        ox[to] = ox[from], oy[to] = oy[from], oz[to] = oz[from];
+        dx[to] = dx[from], dy[to] = dy[from], dz[to] = dz[from];
+        t[to] = t[from], tmax[to] = tmax[from], t0[to] = t0[from], sign[to] = sign[from];
+        w[to] = w[from], a[to] = a[from], b[to] = b[from];
+        om[to] = om[from], pr[to] = pr[from], sl[to] = sl[from];
+        x[to] = x[from], y[to] = y[from], z[to] = z[from], dist[to] = dist[from];
+        for (int k = 0; k < 3; ++k) blo[k][to] = blo[k][from], bhi[k][to] = bhi[k][from];
+        ivlo[to] = ivlo[from], ivhi[to] = ivhi[from], leaf[to] = leaf[from];
+        steps[to] = steps[from], done[to] = done[from], ray[to] = ray[from];
+    }
+    // Where ray i leaves its leaf's box (its t; possibly a little below t[i] by rounding).
+    float exit_t(int i) const {
+        float te = INFINITY;
+        const float o[3] = {ox[i], oy[i], oz[i]}, d[3] = {dx[i], dy[i], dz[i]};
+        for (int k = 0; k < 3; ++k) {
+            if (d[k] > 0.0f) te = std::min(te, (bhi[k][i] - o[k]) / d[k]);
+            else if (d[k] < 0.0f) te = std::min(te, (blo[k][i] - o[k]) / d[k]);
+        }
+        return te;
+    }
+};
+
+// Groups up to kWindow lanes by leaf: order[start[b] .. start[b + 1]) are the lanes of
+// bucket b, whose leaf is key_of[b]. Open addressing with generation stamps (no clearing).
+struct Buckets {
+    static constexpr int kSlots = 1024;
+    static_assert(kSlots >= 2 * kWindow);
+    uint32_t key[kSlots], gen[kSlots] = {};
+    uint16_t id[kSlots];
+    uint32_t cur = 0;
+    uint32_t key_of[kWindow];
+    int count[kWindow + 1], start[kWindow + 1], nb = 0;
+    uint16_t bucket[kWindow], order[kWindow];
+    void build(const uint32_t* leaf, int n) {
+        if (++cur == 0) std::fill_n(gen, kSlots, 0u), cur = 1;
+        nb = 0;
+        for (int i = 0; i < n; ++i) {
+            const uint32_t k = leaf[i];
+            uint32_t h = (k * 2654435761u) >> 22;  // 10 bits
+            while (gen[h] == cur && key[h] != k) h = (h + 1) & (kSlots - 1);
+            if (gen[h] != cur) {
+                gen[h] = cur, key[h] = k, id[h] = static_cast<uint16_t>(nb);
+                key_of[nb] = k, count[nb] = 0;
+                ++nb;
+            }
+            bucket[i] = id[h];
+            ++count[id[h]];
+        }
+        int acc = 0;
+        for (int b = 0; b < nb; ++b) start[b] = acc, acc += count[b];
+        start[nb] = acc;
+        for (int b = 0; b < nb; ++b) count[b] = start[b];
+        for (int i = 0; i < n; ++i) order[count[bucket[i]]++] = static_cast<uint16_t>(i);
+    }
+};
+
+}  // namespace sdfc::cpu

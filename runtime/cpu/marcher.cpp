@@ -1,0 +1,532 @@
+// The marches of a Worker: the lane-window loop (run) that every kind of ray goes through,
+// and what each kind does with its distances. Design:
+//
+//  * Marching: a ray hits when d < epsilon * max(t, 1) (t = path length from the eye, so the
+//    tolerance grows with distance like the pixel footprint, but never below epsilon); it
+//    misses when t passes max_distance or the scene's bounding box. A ray that runs out of
+//    max_steps counts as a hit if it is within one pixel footprint of the surface, else a
+//    miss. NaN distances end the ray as a miss, +inf steps to the end, -inf is a hit. A hit
+//    point moves on by its last distance d (still outside for a 1-Lipschitz bound).
+//  * Over-relaxed sphere tracing (Keinert et al. 2014, omega = 1.5 falling back to 1 when
+//    consecutive unbounding spheres stop overlapping) for camera, secondary and hard shadow
+//    rays: fewer steps, same hits for any 1-Lipschitz bound.
+//  * Shadows: hard (a march toward the light, any hit = 0) when radius == 0, else soft:
+//    Quilez's penumbra estimate with the closest-approach refinement (h, previous h) and the
+//    inner/outer-penumbra form: res = min(d_closest / (w * t)), marching through occluders,
+//    vis = 0.25 (1 + res)^2 (2 - res) for res in [-1, 1]. w = radius / distance for point
+//    lights, w = radius (tangent of the angular radius) for directional ones. Soft shadow
+//    rays are over-relaxed too, but only where d >= 4 w t (far from any penumbra).
+//  * Cone tracing (aa == "cone"): the cone's radius is the pixel footprint r(t). Where the
+//    ray passes an edge (d < r without hitting), the closest approach (smallest d/r) is
+//    recorded as a partial hit of coverage 1 - d/r; up to 4 such layers are composited front
+//    to back, then the final hit (or the background) gets the remaining weight.
+//  * Raw fields (CompiledScene::raw_field, .vm models, no distance bound): see march_raw();
+//    sign-change marching with bisection, hard shadows only, no AO, no cone tracing.
+//  * Tape tree: lanes evaluate their leaf's tape and jump over leaves proven empty
+//    (tape_tree.hpp); each march decides whether a jump is safe for it (its `skip`).
+//
+// Each march keeps its per-lane state in the slots a, b, w, om, pr, sl: the table of what
+// each slot holds for each march is at struct Lanes (lanes.hpp).
+//
+// FP exceptions are never unmasked here, so GCC may if-convert float compares: the lane
+// update loops below vectorise only with this.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("no-trapping-math")
+#endif
+#include <algorithm>
+#include <cmath>
+
+#include "runtime/cpu/worker.hpp"
+
+namespace sdfc::cpu {
+namespace {
+constexpr float kRelaxNear = 8.0f;  // over-relaxed steps only where d >= this many hit thresholds
+constexpr float kSoftRelaxFar = 4.0f;  // soft shadows: over-relaxed only where d >= this x the cone width
+}  // namespace
+
+// Lanes [0, n) whose point left their cached leaf box find their leaf.
+// Then returns in L.idx[0, return) the lanes that may jump (empty leaf for their sign).
+inline int Worker::locate_lanes(Lanes& L, int n) {
+    alignas(64) int32_t out[kWindow];
+    for (int i = 0; i < n; ++i) {
+        const bool in = (L.x[i] >= L.blo[0][i]) & (L.x[i] <= L.bhi[0][i]) & (L.y[i] >= L.blo[1][i]) &
+                        (L.y[i] <= L.bhi[1][i]) & (L.z[i] >= L.blo[2][i]) & (L.z[i] <= L.bhi[2][i]);
+        out[i] = in ? 0 : 1;
+    }
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+        L.idx[m] = i;
+        m += out[i];
+    }
+    for (int j = 0; j < m; ++j) {
+        const int i = L.idx[j];
+        const uint32_t id = T_.locate_from(L.leaf[i], L.x[i], L.y[i], L.z[i]);
+        L.set_leaf(i, id, T_.leaves[id]);
+    }
+    for (int i = 0; i < n; ++i) out[i] = (L.sign[i] > 0.0f ? L.ivlo[i] : -L.ivhi[i]) > 0.0f;
+    m = 0;
+    for (int i = 0; i < n; ++i) {
+        L.idx[m] = i;
+        m += out[i];
+    }
+    return m;
+}
+
+// Collects the finished lanes without branching, then swap-removes them from the highest
+// index down (so the lane moved in is always a live one).
+template <class Finish>
+void Worker::retire(Lanes& L, int& n, Finish&& finish) {
+    int nd = 0;
+    for (int i = 0; i < n; ++i) {
+        L.idx[nd] = i;
+        nd += L.done[i] != 0;
+    }
+    while (nd > 0) {
+        const int i = L.idx[--nd];
+        finish(L, i);
+        if (i != --n) L.move(n, i);
+    }
+}
+
+// Runs the rays of `rs` through the lane window. `init(L, i)` sets up lane i after its
+// ray is loaded; `update(L, n, d)` consumes the distances of lanes [0, n) (a vectorisable
+// loop that advances t and sets L.done); `finish(L, i)` records a finished lane. Rays
+// with an empty [tmin, tmax] go to `empty(r)` without an evaluation.
+// With a tape tree, a lane whose leaf is empty for it (signed lower bound slo > 0) may
+// jump: `skip(L, i, slo, t_exit)` decides (and sets L.t[i] and any state) or returns
+// false; a ray that jumps past tmax ends through `out(L, i)` (which sets a miss) and
+// `finish`. t_exit is where the ray leaves the leaf's box, or tmax if that comes first
+// (nothing beyond tmax is ever sampled).
+template <class Init, class Update, class Finish, class Empty, class Skip, class Out>
+void Worker::run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish, Empty&& empty, Skip&& skip, Out&& out) {
+    Lanes& L = *lanes_;
+    int n = 0;
+    size_t next = 0;
+    const size_t count = rs.size();
+    const bool tree = T_.active;
+    for (;;) {
+        while (n < kWindow && next < count) {
+            const uint32_t r = static_cast<uint32_t>(next++);
+            if (!(rs.tmin[r] <= rs.tmax[r])) {
+                empty(r);
+                continue;
+            }
+            L.load(n, rs, r, f_.relax);
+            init(L, n);
+            ++n;
+        }
+        if (n == 0) return;
+        for (int i = 0; i < n; ++i) {
+            L.x[i] = L.ox[i] + L.t[i] * L.dx[i];
+            L.y[i] = L.oy[i] + L.t[i] * L.dy[i];
+            L.z[i] = L.oz[i] + L.t[i] * L.dz[i];
+        }
+        if (tree) {
+            const int nc = locate_lanes(L, n);
+            bool any_out = false;
+            for (int j = 0; j < nc; ++j) {
+                const int i = L.idx[j];
+                float slo = L.sign[i] > 0.0f ? L.ivlo[i] : -L.ivhi[i];
+                for (int it = 0; slo > 0.0f && it < 64; ++it) {
+                    if (!skip(L, i, slo, std::min(L.exit_t(i), L.tmax[i]))) break;
+                    ++stats.skips;
+                    if (!(L.t[i] <= L.tmax[i])) {
+                        out(L, i);
+                        L.done[i] = 1;
+                        any_out = true;
+                        break;
+                    }
+                    L.x[i] = L.ox[i] + L.t[i] * L.dx[i];
+                    L.y[i] = L.oy[i] + L.t[i] * L.dy[i];
+                    L.z[i] = L.oz[i] + L.t[i] * L.dz[i];
+                    const uint32_t id = T_.locate_from(L.leaf[i], L.x[i], L.y[i], L.z[i]);
+                    L.set_leaf(i, id, T_.leaves[id]);
+                    slo = L.sign[i] > 0.0f ? L.ivlo[i] : -L.ivhi[i];
+                }
+            }
+            if (any_out) {
+                retire(L, n, finish);
+                if (n == 0) continue;
+            }
+            eval_grouped(L.x, L.y, L.z, L.leaf, n, L.dist);
+        } else {
+            eval_leaf(0, L.x, L.y, L.z, n, L.dist);
+        }
+        update(L, n, static_cast<const float*>(L.dist));
+        retire(L, n, finish);
+    }
+}
+
+// The jump of an (over-relaxed) sphere-traced lane in an empty leaf: only if no point of
+// the leaf could stop the ray (slo >= its hit threshold up to the landing point). Lands
+// slo beyond the box's exit: the exit point is in the box, so its distance is >= slo.
+// If the check of the last over-relaxed step is not sure to pass (r >= slo is all we
+// know), it is treated as failed instead, without an evaluation: back to the previous
+// sphere's boundary, omega = 1 (as march() does), and the jump is decided from there.
+inline bool Worker::skip_sphere(Lanes& L, int i, float slo, float te) {
+    if (L.om[i] > 1.0f && slo + L.pr[i] < L.sl[i]) {
+        L.t[i] += L.pr[i] - L.sl[i];
+        L.om[i] = 1.0f, L.pr[i] = 0.0f, L.sl[i] = 0.0f;
+        return true;
+    }
+    const float tn = std::max(te, L.t[i]) + slo;
+    if (!(slo >= f_.thr(L.t0[i] + tn))) return false;
+    L.t[i] = tn;
+    L.pr[i] = 0.0f, L.sl[i] = 0.0f;
+    return true;
+}
+
+// Sphere tracing (outside rays on d, inside rays on -d). Results in t_, hit_, steps_.
+void Worker::march(const RaySet& rs) {
+    if (f_.raw) return march_raw(rs, false);
+    const size_t n = rs.size();
+    t_.resize(n);
+    hit_.assign(n, 0);
+    steps_.assign(n, 0);
+    const int max_steps = f_.max_steps;
+    const float eps = f_.eps;
+    run(
+        rs, [](Lanes&, int) {},
+        [&](Lanes& L, int m, const float* d) {
+            for (int i = 0; i < m; ++i) {
+                const float s = L.sign[i] * d[i], r = std::fabs(s);
+                // Over-relaxation: step omega * d while consecutive unbounding spheres
+                // overlap; when they do not, or the step went through the surface (s < 0),
+                // a surface may lie between: step back inside the previous sphere and
+                // continue with omega = 1. Near the surface (d within kRelaxNear hit
+                // thresholds) the steps are plain, so that grazing rays are sampled where
+                // plain sphere tracing samples them and hit or miss alike.
+                const float thr = eps * std::max(L.t0[i] + L.t[i], 1.0f);
+                const bool fail = (L.om[i] > 1.0f) & (L.sl[i] > L.pr[i]) & ((r + L.pr[i] < L.sl[i]) | (s < 0.0f));
+                // (A relaxed step past tmax is not taken: only a plain step may end the ray.)
+                const float om = (s > kRelaxNear * thr) & (L.t[i] + L.om[i] * s <= L.tmax[i]) ? L.om[i] : 1.0f;
+                const float step = fail ? L.pr[i] - L.sl[i] : om * s;
+                L.om[i] = fail ? 1.0f : L.om[i];
+                L.sl[i] = step;
+                L.pr[i] = r;
+                const int st = ++L.steps[i];
+                const bool stop = ((s < thr) & !fail) | (st >= max_steps);  // hit, or out of steps (decided in finish)
+                const float tn = L.t[i] + step;
+                const bool out = !(tn <= L.tmax[i]);  // also NaN
+                L.a[i] = fail ? INFINITY : s;
+                L.t[i] = stop ? L.t[i] : tn;
+                L.done[i] = stop | out;
+            }
+        },
+        [&](Lanes& L, int i) {
+            const uint32_t r = L.ray[i];
+            const float s = L.a[i], path = L.t0[i] + L.t[i];
+            steps_[r] = L.steps[i];
+            hit_[r] = s < f_.thr(path) || (L.steps[i] >= max_steps && s < f_.footprint(path));
+            // A hit moves on by its last distance: still outside (1-Lipschitz), and much
+            // closer to the surface, wherever the last step began (same with --baseline).
+            t_[r] = hit_[r] && s > 0.0f ? L.t[i] + s : L.t[i];
+        },
+        [&](uint32_t r) { t_[r] = rs.tmax[r]; },
+        [&](Lanes& L, int i, float slo, float te) { return skip_sphere(L, i, slo, te); },
+        [](Lanes& L, int i) { L.a[i] = INFINITY, L.t[i] = L.tmax[i]; });
+}
+
+// Marching a raw field (no distance bound): steps of |f| / L, with L a Lipschitz estimate
+// sampled over the volume (make_frame, frame.cpp), clamped to [one pixel footprint, raw_max_step]; a
+// sign change (f <= 0) is refined by bisection to the outside end of the bracket. Thin features
+// (under a pixel or where the estimate is low) can be missed: the price of no bound.
+// Lane state: a = previous t, b / w = bisection bracket (lo, hi), sl = bisection iterations
+// (0 while marching), om = 1 when the ray ended as a hit.
+// `shadow`: results go to vis_ (0 = blocked) instead of t_ / hit_ / steps_.
+void Worker::march_raw(const RaySet& rs, bool shadow) {
+    const size_t n = rs.size();
+    if (shadow) {
+        vis_.assign(n, 1.0f);
+    } else {
+        t_.resize(n);
+        hit_.assign(n, 0);
+        steps_.assign(n, 0);
+    }
+    const int max_steps = f_.max_steps;
+    constexpr int kBisect = 12;
+    const float inv_l = 1.0f / f_.raw_lipschitz;
+    run(
+        rs, [](Lanes& L, int i) { L.a[i] = -1.0f, L.sl[i] = 0.0f, L.om[i] = 0.0f; },
+        [&](Lanes& L, int m, const float* dist) {
+            for (int i = 0; i < m; ++i) {
+                const float s = L.sign[i] * dist[i], t = L.t[i], path = L.t0[i] + t;
+                const int st = ++L.steps[i];
+                bool done = false, hit = false;
+                if (L.sl[i] > 0.0f) {
+                    // Bisection: keep the outside end in b, the inside end in w.
+                    if (s < 0.0f) L.w[i] = t;
+                    else L.b[i] = t;
+                    L.sl[i] += 1.0f;
+                    if (L.sl[i] > kBisect || L.w[i] - L.b[i] < f_.thr(path)) {
+                        L.t[i] = L.b[i];
+                        done = hit = true;
+                    } else {
+                        L.t[i] = 0.5f * (L.b[i] + L.w[i]);
+                    }
+                } else if (s <= 0.0f) {  // a sign change (values are not distances: "close" means nothing)
+                    if (s == 0.0f || L.a[i] < 0.0f || shadow) {
+                        done = hit = true;
+                    } else {
+                        L.b[i] = L.a[i], L.w[i] = t, L.sl[i] = 1.0f;
+                        L.t[i] = 0.5f * (L.b[i] + L.w[i]);
+                    }
+                } else {
+                    const float step = s == s ? std::clamp(s * inv_l, f_.footprint(path), f_.raw_max_step) : f_.footprint(path);
+                    L.a[i] = t;
+                    L.t[i] = t + step;
+                    done = !(L.t[i] <= L.tmax[i]);
+                }
+                if (!done && st >= max_steps) {
+                    done = true;
+                    hit = L.sl[i] > 0.0f;  // inside a bracket: take its outside end
+                    if (hit) L.t[i] = L.b[i];
+                }
+                L.om[i] = hit ? 1.0f : 0.0f;
+                L.done[i] = done;
+            }
+        },
+        [&](Lanes& L, int i) {
+            const uint32_t r = L.ray[i];
+            if (shadow) {
+                vis_[r] = L.om[i] > 0.0f ? 0.0f : 1.0f;
+                return;
+            }
+            t_[r] = L.t[i];
+            hit_[r] = L.om[i] > 0.0f;
+            steps_[r] = L.steps[i];
+        },
+        [&](uint32_t r) {
+            if (!shadow) t_[r] = rs.tmax[r];
+        },
+        [&](Lanes& L, int i, float, float te) {
+            // No sign change in an empty leaf: past its exit (a quarter pixel beyond, for
+            // progress); the current point is the outside end of a later bracket.
+            if (L.sl[i] > 0.0f) return false;  // bisecting
+            const float t = L.t[i], tn = std::max(te, t);
+            L.a[i] = t;
+            L.t[i] = tn + 0.25f * f_.footprint(L.t0[i] + tn) + 1e-6f * tn;
+            return true;
+        },
+        [](Lanes& L, int i) { L.om[i] = 0.0f, L.t[i] = L.tmax[i]; });
+}
+
+// Cone tracing of primary rays: fills ev_* (partial hits), t_/hit_ (final hit), trans_
+// (weight left for the final hit or the background) and steps_.
+void Worker::cone_march(const RaySet& rs) {
+    const size_t n = rs.size();
+    t_.resize(n);
+    hit_.assign(n, 0);
+    steps_.assign(n, 0);
+    ev_n_.assign(n, 0);
+    ev_t_.resize(n * kConeEvents);
+    ev_w_.resize(n * kConeEvents);
+    trans_.assign(n, 1.0f);
+    const int max_steps = f_.max_steps;
+    auto emit = [&](uint32_t r, float t, float coverage) {
+        int& k = ev_n_[r];
+        if (k >= kConeEvents || !(coverage > 0.0f)) return;
+        ev_t_[r * kConeEvents + k] = t;
+        ev_w_[r * kConeEvents + k] = trans_[r] * coverage;
+        trans_[r] *= 1.0f - coverage;
+        ++k;
+    };
+    // Lane state: a = smallest d / r in the current edge zone (>= 1: none), b = its t,
+    // w = 1 when the final state is a hit.
+    run(
+        rs, [](Lanes& L, int i) { L.a[i] = 2.0f; },
+        [&](Lanes& L, int m, const float* dist) {
+            for (int i = 0; i < m; ++i) {
+                const uint32_t r = L.ray[i];
+                const float d = dist[i], t = L.t[i], path = L.t0[i] + t;
+                const float radius = std::max(f_.footprint(path), 1e-30f);
+                const int st = ++L.steps[i];
+                bool done = false, hit = false;
+                if (d < f_.thr(path)) {
+                    done = hit = true;  // the axis hits: this surface takes the remaining weight
+                } else if (!(d == d)) {
+                    done = true;
+                } else {
+                    const float rho = d / radius;
+                    if (rho < 1.0f) {
+                        if (rho < L.a[i]) L.a[i] = rho, L.b[i] = t;
+                    } else if (L.a[i] < 1.0f) {
+                        emit(r, L.b[i], 1.0f - L.a[i]);  // left an edge zone: composite its closest approach
+                        L.a[i] = 2.0f;
+                    }
+                    if (trans_[r] < 1e-3f) {
+                        done = true;  // fully covered by edges
+                    } else if (st >= max_steps) {
+                        done = true;
+                        hit = d < radius;
+                    } else {
+                        L.t[i] = t + d;
+                        done = !(L.t[i] <= L.tmax[i]);
+                    }
+                    if (done && !hit && L.a[i] < 1.0f) emit(r, L.b[i], 1.0f - L.a[i]);
+                }
+                L.w[i] = hit ? 1.0f : 0.0f;
+                L.done[i] = done;
+            }
+        },
+        [&](Lanes& L, int i) {
+            const uint32_t r = L.ray[i];
+            t_[r] = L.t[i];
+            hit_[r] = L.w[i] > 0.0f;
+            steps_[r] = L.steps[i];
+        },
+        [&](uint32_t r) { t_[r] = rs.tmax[r]; },
+        [&](Lanes& L, int i, float slo, float te) {
+            // Only where the cone cannot touch anything in the leaf (d >= its radius); leaving
+            // an edge zone composites it, as the update would.
+            const float tn = std::max(te, L.t[i]) + slo, path = L.t0[i] + tn;
+            if (!(slo >= f_.thr(path) && slo >= f_.footprint(path))) return false;
+            if (L.a[i] < 1.0f) {
+                emit(L.ray[i], L.b[i], 1.0f - L.a[i]);
+                L.a[i] = 2.0f;
+            }
+            L.t[i] = tn;
+            return true;
+        },
+        [](Lanes& L, int i) { L.w[i] = 0.0f, L.t[i] = L.tmax[i]; });
+}
+
+// Hard shadows: vis_[i] = 0 if the segment hits anything, else 1.
+void Worker::shadow_hard(const RaySet& rs) {
+    vis_.assign(rs.size(), 1.0f);
+    const int max_steps = f_.max_steps;
+    const float eps = f_.eps;
+    run(
+        rs, [](Lanes&, int) {},
+        [&](Lanes& L, int m, const float* d) {
+            for (int i = 0; i < m; ++i) {
+                // Over-relaxed like march() (plain near surfaces); a blocker only counts at a
+                // safe point (a point inside an occluder is one: it blocks).
+                const float r = std::fabs(d[i]);
+                const float thr = eps * std::max(L.t0[i] + L.t[i], 1.0f);
+                const bool fail = (L.om[i] > 1.0f) & (L.sl[i] > L.pr[i]) & (r + L.pr[i] < L.sl[i]);
+                const float om = (d[i] > kRelaxNear * thr) & (L.t[i] + L.om[i] * d[i] < L.tmax[i]) ? L.om[i] : 1.0f;
+                const float step = fail ? L.pr[i] - L.sl[i] : om * d[i];
+                L.om[i] = fail ? 1.0f : L.om[i];
+                L.sl[i] = step;
+                L.pr[i] = r;
+                const int st = ++L.steps[i];
+                const bool stop = ((d[i] < thr) & !fail) | (st >= max_steps);
+                const float tn = L.t[i] + step;
+                const bool out = !(tn < L.tmax[i]);  // also NaN: no occluder found
+                L.a[i] = fail ? INFINITY : d[i];
+                L.t[i] = stop ? L.t[i] : tn;
+                L.done[i] = stop | out;
+            }
+        },
+        [&](Lanes& L, int i) {
+            const float d = L.a[i], path = L.t0[i] + L.t[i];
+            const bool blocked = d < f_.thr(path) || (L.steps[i] >= max_steps && d < f_.footprint(path));
+            vis_[L.ray[i]] = blocked ? 0.0f : 1.0f;
+        },
+        [](uint32_t) {}, [&](Lanes& L, int i, float slo, float te) { return skip_sphere(L, i, slo, te); },
+        [](Lanes& L, int i) { L.a[i] = INFINITY, L.t[i] = L.tmax[i]; });
+}
+
+// Soft shadows; sw_[i] is the light's angular width (tangent) seen from ray i.
+// Lane state: a = res (the smallest cone fraction), b = the previous positive distance.
+// Over-relaxed like march() (om, pr, sl), but only far from any penumbra (estimate >= 2)
+// and from surfaces, so the samples that decide res are where plain tracing takes them.
+void Worker::shadow_soft(const RaySet& rs) {
+    vis_.assign(rs.size(), 1.0f);
+    const int max_steps = f_.max_steps;
+    const float eps = f_.eps;
+    run(
+        rs,
+        [&](Lanes& L, int i) {
+            L.w[i] = sw_[L.ray[i]];
+            L.a[i] = 1.0f;
+            L.b[i] = 1e20f;
+        },
+        [&](Lanes& L, int m, const float* dist) {
+            for (int i = 0; i < m; ++i) {
+                const float h = dist[i], t = L.t[i], w = L.w[i], r = std::fabs(h);
+                const float thr = eps * std::max(L.t0[i] + t, 1.0f);
+                const bool pos = h > 0.0f;
+                // The last over-relaxed step left the previous sphere (or entered a solid):
+                // back to that sphere's boundary, plain steps from there; no sample taken.
+                const bool fail = (L.om[i] > 1.0f) & (L.sl[i] > L.pr[i]) & ((r + L.pr[i] < L.sl[i]) | !pos);
+                // Closest approach between this sample and the previous one (Quilez 2018;
+                // for a step s longer than the previous distance b, the point both spheres
+                // touch: y = (s^2 + h^2 - b^2) / 2s, which is h^2 / 2b when s = b);
+                // inside an occluder, the (negative) depth relative to the cone.
+                const float pb = L.b[i], ps = L.sl[i];
+                const float y0 = ps > pb && pb < 1e19f ? (ps * ps + h * h - pb * pb) / (2.0f * ps) : h * h / (2.0f * pb);
+                const float y = std::min(std::max(y0, 0.0f), 0.999f * h);
+                const float dd = std::sqrt(std::max(h * h - y * y, 0.0f));
+                const float est = pos ? dd / (w * std::max(t - y, 1e-20f)) : h / (w * std::max(t, 1e-20f));
+                const float res = (est < L.a[i]) & !fail ? est : L.a[i];  // NaN keeps res
+                L.a[i] = res;
+                L.b[i] = fail ? L.b[i] : (pos ? h : 1e20f);
+                // Sphere tracing outside; through an occluder in steps of a quarter cone width.
+                const bool far = pos & (h > kSoftRelaxFar * w * t) & (h > kRelaxNear * thr) & (t + L.om[i] * h < L.tmax[i]);
+                const float om = far ? L.om[i] : 1.0f;
+                const float step = fail ? L.pr[i] - L.sl[i] : pos ? std::max(om * h, thr) : std::max(0.25f * w * t, thr);
+                L.om[i] = fail ? 1.0f : L.om[i];
+                L.sl[i] = step;
+                L.pr[i] = r;
+                const float tn = t + step;
+                L.t[i] = tn;
+                const int st = ++L.steps[i];
+                L.done[i] = (h != h) | (res <= -1.0f) | (st >= max_steps) | !(tn < L.tmax[i]);
+            }
+        },
+        [&](Lanes& L, int i) {
+            const float res = std::clamp(L.a[i], -1.0f, 1.0f);
+            vis_[L.ray[i]] = 0.25f * (1.0f + res) * (1.0f + res) * (2.0f - res);
+        },
+        [](uint32_t) {},
+        [&](Lanes& L, int i, float slo, float te) {
+            if (L.om[i] > 1.0f && slo + L.pr[i] < L.sl[i]) {  // as in skip_sphere()
+                L.t[i] += L.pr[i] - L.sl[i];
+                L.om[i] = 1.0f, L.pr[i] = 0.0f, L.sl[i] = 0.0f;
+                return true;
+            }
+            // Only where every estimate in the leaf would be >= 2 (no penumbra there, with a
+            // margin): d / (w t) >= slo / (w t_landing).
+            const float tn = std::max(te, L.t[i]) + slo;
+            if (!(slo >= 2.0f * L.w[i] * tn)) return false;
+            L.t[i] = tn;
+            L.b[i] = 1e20f;
+            L.pr[i] = 0.0f, L.sl[i] = 0.0f;
+            return true;
+        },
+        [](Lanes& L, int i) { L.t[i] = L.tmax[i]; });
+}
+
+// Tile cone pre-marching: one march along the tile's central ray for all its primary rays.
+// Every ray of the tile (directions within the corners' cone, origins within the corners')
+// stays within R(t) = r0 + t * r1 of the axis point at the same t, so when the axis has
+// distance d at t, the ball of radius d around it holds every ray's points up to t + step
+// for step = d - R(t) - thr(t + d): no surface there, nor any point where plain tracing
+// would stop (d >= its hit threshold). The rays then start at the final t.
+float Worker::tile_start(int x0, int y0, int x1, int y1) {
+    const Ray c = f_.camera.ray(0.5f * static_cast<float>(x0 + x1), 0.5f * static_cast<float>(y0 + y1));
+    float r0 = 0.0f, r1 = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+        const Ray q = f_.camera.ray(static_cast<float>(k & 1 ? x1 : x0), static_cast<float>(k & 2 ? y1 : y0));
+        r0 = std::max(r0, glm::length(q.origin - c.origin));
+        r1 = std::max(r1, glm::length(q.dir - c.dir));
+    }
+    r0 = r0 * 1.01f + 1e-6f, r1 = r1 * 1.01f + 1e-6f;  // rounding margin
+    float t = 0.0f, tmax = f_.max_dist;
+    f_.clip_ray(c.origin, c.dir, t, tmax);  // (not the start: other rays may enter the box sooner)
+    t = 0.0f;
+    constexpr int kMaxConeSteps = 32;
+    for (int i = 0; i < kMaxConeSteps && t < f_.max_dist; ++i) {
+        const glm::vec3 p = c.origin + c.dir * t;
+        float d;
+        eval_points(&p.x, &p.y, &p.z, 1, &d);
+        const float step = d - (r0 + r1 * t) - f_.thr(t + d);
+        if (!(step > 1e-3f * std::max(t, 1.0f))) break;  // also NaN
+        t += step;
+    }
+    return t;
+}
+
+}  // namespace sdfc::cpu

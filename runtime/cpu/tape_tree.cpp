@@ -1,0 +1,328 @@
+// Building the tape tree (tape_tree.hpp). Best first: the cells worth splitting wait in a
+// queue ordered by tape length x size^2 (roughly the evaluations a split saves: long tapes,
+// big surfaces), and rounds of up to kTreeRound of them are split in parallel until the
+// queue empties or the work budget (instructions interval-evaluated) runs out.
+// Deterministic for any thread count.
+// `lipschitz`: the program is a 1-Lipschitz distance bound, so a child's interval can be
+// tightened with the value at its centre c: d(p) is within |p - c| of d(c). That rescues
+// fields whose intervals are weak far away (rotations by an angle that depends on the
+// point: twist, bend). The tightened bounds decide splits and rays' jumps (as safe as a
+// sphere-tracing step); tape simplification uses the interval choices alone.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("no-trapping-math")  // as in marcher.cpp
+#endif
+#include "runtime/cpu/tape_tree.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <deque>
+#include <memory>
+#include <queue>
+
+#include "runtime/cpu/float_ops.hpp"
+#include "runtime/eval/interval.hpp"
+#include "runtime/eval/vm.hpp"
+
+namespace sdfc::cpu {
+namespace {
+
+constexpr int kTreeMaxDepth = 16;
+constexpr size_t kTreeLeafTape = 64;      // tapes this short are not split further
+constexpr size_t kTreePilot = 32;          // after splits worth this many programs ...
+constexpr double kTreeUseless = 0.6;      // ... surface cells' tapes this long: no tree
+constexpr size_t kTreeMaxNodes = size_t(1) << 20;
+constexpr int kTreeMaxStall = 3;          // splits in a row that did not shorten tapes (x 0.9)
+constexpr float kTreeNear = 0.25f;        // empty cells are split when the surface is this near (x size)
+constexpr size_t kTreeRound = 64;         // cells split in parallel per round
+// Build work budget (instructions interval-evaluated, 8 boxes at a time): a constant, plus
+// per program instruction, plus per sample of the image (the evaluations it will save).
+constexpr size_t kTreeWorkPerInstr = 64, kTreeWorkBase = size_t(16) << 10, kTreeWorkPerSample = 1;
+constexpr uint32_t kNone = 0xFFFFFFFFu;
+
+struct TreeCell {
+    glm::vec3 lo{0}, hi{0};
+    float ivlo = -INFINITY, ivhi = INFINITY;
+    int depth = 0, stall = 0;
+    // An empty (or solid) cell that will not be split runs its parent's tape (valid in the
+    // parent's box, hence in its own): ref_cell is the parent.
+    uint32_t ref_cell = kNone;
+    Tape tape;
+};
+
+// Empty (ivlo > 0) or solid (ivhi < 0): no surface inside.
+bool settled(float ivlo, float ivhi) { return ivlo > 0.0f || ivhi < 0.0f; }
+// An empty or solid cell is still split when the surface is within kTreeNear of its size
+// (rays, normal and AO taps and soft shadows evaluate there).
+bool near_surface(const TreeCell& c) {
+    const float size = max3(c.hi - c.lo), d = c.ivlo > 0.0f ? c.ivlo : -c.ivhi;
+    return d < kTreeNear * size;
+}
+
+bool want_split(const TreeCell& c) {
+    if (c.ref_cell != kNone) return false;
+    if (c.depth >= kTreeMaxDepth || c.tape.code.size() <= kTreeLeafTape || c.stall >= kTreeMaxStall) return false;
+    const float size = max3(c.hi - c.lo);
+    if (!(size > 0.0f) || !std::isfinite(size)) return false;
+    return !settled(c.ivlo, c.ivhi) || near_surface(c);  // may hold the surface, or unknown (NaN)
+}
+
+// Per-thread evaluators of the build, grown to the largest tape seen.
+struct TreeScratch {
+    std::unique_ptr<IntervalEvaluator> iv;
+    uint32_t regs = 0, choices = 0;
+    BatchScratch bs;
+    uint64_t boxes = 0;
+    std::unique_ptr<Program> vm_regs;  // sizes `vm` (eval_code only)
+    std::unique_ptr<Evaluator> vm;
+    IntervalEvaluator& get(uint32_t r, uint32_t c) {
+        if (!iv || r > regs || c > choices) {
+            regs = std::max(regs, r);
+            choices = std::max(choices, c);
+            iv = std::make_unique<IntervalEvaluator>(regs, choices);
+        }
+        return *iv;
+    }
+    Evaluator& point_vm(uint32_t r) {
+        if (!vm || r > vm_regs->num_regs) {
+            vm.reset();
+            vm_regs = std::make_unique<Program>();
+            vm_regs->num_regs = std::max<uint32_t>(r, 64);
+            vm = std::make_unique<Evaluator>(*vm_regs);
+        }
+        return *vm;
+    }
+};
+
+// The cells of one build (cell i becomes node i), the queue of cells worth splitting and
+// the work spent against the budget.
+class TreeBuilder {
+public:
+    TreeBuilder(const Program& p, glm::vec3 lo, glm::vec3 hi, float time, bool lipschitz, size_t samples)
+        : p_(p), time_(time), lipschitz_(lipschitz),
+          budget_(kTreeWorkBase + kTreeWorkPerInstr * p.code.size() + kTreeWorkPerSample * samples) {
+        cells_[0].lo = lo, cells_[0].hi = hi;
+        cells_[0].tape = Tape::from(p, 0);
+        consider(0);
+    }
+
+    bool queued() const { return !queue_.empty(); }
+
+    // Once the tree is a few levels deep (checked once): if the tapes of the cells that may
+    // hold the surface are not much shorter than the program (smooth blends, domain
+    // repetition: nothing for the intervals to decide), the lookups would cost more than
+    // they save. True when that is the case.
+    bool pilot_rejects() {
+        if (checked_ || work_ < kTreePilot * p_.code.size()) return false;
+        checked_ = true;
+        size_t n = 0, len = 0;
+        for (size_t i = 0; i < cells_.size(); ++i)
+            if (first_child_[i] == kNone && cells_[i].ref_cell == kNone && !settled(cells_[i].ivlo, cells_[i].ivhi))
+                ++n, len += cells_[i].tape.code.size();
+        return n > 0 && static_cast<double>(len) > kTreeUseless * static_cast<double>(n) * static_cast<double>(p_.code.size());
+    }
+
+    // Takes the next round off the queue, best first, while the budget and the node limit
+    // allow; false when not even one cell fits.
+    bool take_round() {
+        round_.clear();
+        while (!queue_.empty() && round_.size() < kTreeRound && cells_.size() + 8 * (round_.size() + 1) <= kTreeMaxNodes) {
+            const uint32_t i = ~queue_.top().second;
+            const size_t len = cells_[i].tape.code.size();
+            if (work_ + len > budget_) break;
+            queue_.pop();
+            work_ += len;
+            round_.push_back(i);
+        }
+        return !round_.empty();
+    }
+
+    // Splits the round's cells in parallel, then queues those of their children worth
+    // splitting (in cell order, so the queue is the same for any thread count).
+    void split_round() {
+        const uint32_t base = static_cast<uint32_t>(cells_.size());
+        cells_.resize(cells_.size() + 8 * round_.size());
+        first_child_.resize(cells_.size(), kNone);
+        keep_.resize(cells_.size(), 0);
+        for (size_t q = 0; q < round_.size(); ++q) first_child_[round_[q]] = base + static_cast<uint32_t>(8 * q);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, round_.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+            TreeScratch& s = scratch_.local();
+            for (size_t q = r.begin(); q != r.end(); ++q) split(s, round_[q]);
+        });
+        for (size_t q = 0; q < round_.size(); ++q)
+            for (uint32_t k = 0; k < 8; ++k) consider(first_child_[round_[q]] + k);
+    }
+
+    bool any_split() const { return cells_.size() > 1; }
+    uint64_t boxes() const {
+        uint64_t n = 0;
+        for (const TreeScratch& s : scratch_) n += s.boxes;
+        return n;
+    }
+    // Nodes, leaves and tapes into T, in cell order (deterministic; parents precede children).
+    void emit(TapeTree& T);
+
+private:
+    void consider(uint32_t i) {
+        const TreeCell& c = cells_[i];
+        if (!want_split(c)) return;
+        const double size = max3(c.hi - c.lo);
+        const double prio = static_cast<double>(c.tape.code.size()) * size * size * (settled(c.ivlo, c.ivhi) ? 0.25 : 1.0);
+        queue_.emplace(prio, ~i);
+    }
+    void split(TreeScratch& s, uint32_t i);
+
+    const Program& p_;
+    const float time_;
+    const bool lipschitz_;
+    const size_t budget_;
+    size_t work_ = 0;
+    bool checked_ = false;
+    std::deque<TreeCell> cells_ = std::deque<TreeCell>(1);  // a deque: growing moves nothing
+    std::vector<uint32_t> first_child_ = std::vector<uint32_t>(1, kNone);
+    std::vector<uint8_t> keep_ = std::vector<uint8_t>(1, 0);  // the cell's tape is run by settled children
+    using Item = std::pair<double, uint32_t>;  // (priority, ~index): ties go to the lower index
+    std::priority_queue<Item> queue_;
+    std::vector<uint32_t> round_;
+    tbb::enumerable_thread_specific<TreeScratch> scratch_;
+};
+
+// Cell i's 8 children: their boxes, intervals (tightened by centre values where the
+// intervals alone leave them ambiguous), and simplified tapes, or a reference to this
+// cell's tape for those that will not be split.
+void TreeBuilder::split(TreeScratch& s, uint32_t i) {
+    TreeCell& c = cells_[i];
+    const uint32_t first = first_child_[i];
+    const glm::vec3 mid = 0.5f * (c.lo + c.hi);
+    float bx[6][kIvLanes];
+    for (int k = 0; k < 8; ++k)
+        for (int a = 0; a < 3; ++a) {
+            const bool upper = (k >> a) & 1;
+            bx[2 * a][k] = upper ? mid[a] : c.lo[a];
+            bx[2 * a + 1][k] = upper ? c.hi[a] : mid[a];
+        }
+    if (!c.tape.linked) c.tape.link();
+    IntervalEvaluator& iv = s.get(c.tape.num_regs, c.tape.choices);
+    iv.eval(c.tape, bx[0], bx[1], bx[2], bx[3], bx[4], bx[5], 8, time_);
+    s.boxes += 8;
+    // Children the intervals leave ambiguous: tighten with the centre values (one
+    // evaluation of this cell's tape at the 8 centres).
+    bool ambiguous = false;
+    for (int k = 0; k < 8; ++k) ambiguous |= !settled(iv.result(k).lo, iv.result(k).hi);
+    float dc[8];
+    std::fill_n(dc, 8, NAN);
+    if (lipschitz_ && ambiguous) {
+        alignas(64) float cx[kBatch], cy[kBatch], cz[kBatch];
+        for (int k = 0; k < 8; ++k) {
+            cx[k] = 0.5f * (bx[0][k] + bx[1][k]);
+            cy[k] = 0.5f * (bx[2][k] + bx[3][k]);
+            cz[k] = 0.5f * (bx[4][k] + bx[5][k]);
+        }
+        Evaluator& vm = s.point_vm(c.tape.num_regs);
+        vm.eval_code(c.tape.code.data(), c.tape.code.size(), cx, cy, cz, 8, time_);
+        std::copy_n(vm.reg_data(c.tape.out), 8, dc);
+    }
+    bool kept = false;
+    uint64_t lanes = 0;
+    for (int k = 0; k < 8; ++k) {
+        TreeCell& ch = cells_[first + static_cast<uint32_t>(k)];
+        ch.lo = glm::vec3(bx[0][k], bx[2][k], bx[4][k]);
+        ch.hi = glm::vec3(bx[1][k], bx[3][k], bx[5][k]);
+        const Interval v = iv.result(k);
+        ch.ivlo = v.lo, ch.ivhi = v.hi;
+        if (std::isfinite(dc[k])) {
+            const float r = 0.5f * glm::length(ch.hi - ch.lo) * (1.0f + 1e-5f) + 1e-6f * (1.0f + std::fabs(dc[k]));
+            if (!(ch.ivlo >= dc[k] - r)) ch.ivlo = dc[k] - r;  // also replaces NaN
+            if (!(ch.ivhi <= dc[k] + r)) ch.ivhi = dc[k] + r;
+        }
+        ch.depth = c.depth + 1;
+        if (settled(ch.ivlo, ch.ivhi) && !(ch.depth < kTreeMaxDepth && c.tape.code.size() > kTreeLeafTape && near_surface(ch))) {
+            ch.ref_cell = i;  // will not be split: runs this cell's tape
+            kept = true;
+            continue;
+        }
+        lanes |= uint64_t(1) << k;
+    }
+    size_t sum = 0, nsimp = 0;
+    if (lanes) simplify_batch(c.tape, iv.choices(), iv.stride(), lanes, s.bs, true);
+    for (int k = 0; k < 8; ++k) {
+        if (!((lanes >> k) & 1)) continue;
+        TreeCell& ch = cells_[first + static_cast<uint32_t>(k)];
+        ch.tape.assign(s.bs.code(k), s.bs.len[size_t(k)], s.bs.out[size_t(k)], s.bs.regs[size_t(k)]);
+        sum += ch.tape.code.size();
+        ++nsimp;
+    }
+    // A split that left the children's tapes about as long as this one (an
+    // unprunable field) counts against splitting them again.
+    const bool useless = nsimp > 0 && sum * 10 >= c.tape.code.size() * nsimp * 9;
+    for (int k = 0; k < 8; ++k) cells_[first + static_cast<uint32_t>(k)].stall = useless ? c.stall + 1 : 0;
+    keep_[i] = kept;
+    if (!kept) c.tape = Tape{};  // no longer needed: free it now
+}
+
+void TreeBuilder::emit(TapeTree& T) {
+    T.nodes.resize(cells_.size());
+    T.boxes_.resize(cells_.size());
+    std::vector<TapeTree::Leaf> kept_at(cells_.size());
+    T.tapes.reserve(cells_.size() + 1);  // (moves only: the leaves' code pointers stay valid)
+    for (size_t i = 0; i < cells_.size(); ++i) {
+        TreeCell& c = cells_[i];
+        TapeTree::Node& node = T.nodes[i];
+        for (int a = 0; a < 3; ++a) T.boxes_[i].lo[a] = c.lo[a], T.boxes_[i].hi[a] = c.hi[a];
+        if (first_child_[i] != kNone) {
+            const glm::vec3 mid = 0.5f * (c.lo + c.hi);
+            for (int a = 0; a < 3; ++a) node.c[a] = mid[a];
+            node.child = first_child_[i];
+            for (uint32_t k = 0; k < 8; ++k) T.boxes_[first_child_[i] + k].parent = static_cast<uint32_t>(i);
+            if (keep_[i]) {
+                kept_at[i].len = static_cast<uint32_t>(c.tape.code.size());
+                kept_at[i].out = c.tape.out;
+                T.tapes.push_back(std::move(c.tape.code));
+                kept_at[i].code = T.tapes.back().data();
+                T.max_regs = std::max(T.max_regs, c.tape.num_regs);
+            }
+            continue;
+        }
+        TapeTree::Leaf L{};
+        for (int a = 0; a < 3; ++a) L.lo[a] = c.lo[a], L.hi[a] = c.hi[a];
+        L.ivlo = c.ivlo, L.ivhi = c.ivhi;
+        L.node = static_cast<uint32_t>(i);
+        if (c.ref_cell != kNone) {
+            const TapeTree::Leaf& k = kept_at[c.ref_cell];
+            L.code = k.code, L.len = k.len, L.out = k.out;
+        } else {
+            L.len = static_cast<uint32_t>(c.tape.code.size());
+            L.out = c.tape.out;
+            T.tapes.push_back(std::move(c.tape.code));
+            L.code = T.tapes.back().data();
+            T.max_regs = std::max(T.max_regs, c.tape.num_regs);
+        }
+        node.child = TapeTree::kLeafBit | static_cast<uint32_t>(T.leaves.size());
+        T.leaves.push_back(L);
+    }
+}
+
+}  // namespace
+
+void build_tree(TapeTree& T, const Program& p, glm::vec3 lo, glm::vec3 hi, float time, bool lipschitz, size_t samples) {
+    T.init_full(p);
+    T.lo = lo;
+    T.hi = hi;
+    T.active = true;
+    TreeBuilder b(p, lo, hi, time, lipschitz, samples);
+    bool worth_it = true;
+    while (b.queued()) {
+        if (b.pilot_rejects()) {
+            worth_it = false;
+            break;
+        }
+        if (!b.take_round()) break;
+        b.split_round();
+    }
+    T.boxes += b.boxes();
+    if (!worth_it || !b.any_split()) return T.init_full(p);  // no tree: leaf 0 only
+    b.emit(T);
+}
+
+}  // namespace sdfc::cpu

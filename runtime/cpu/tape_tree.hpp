@@ -1,0 +1,98 @@
+// The tape tree: an octree over a root box around the scene, built once per frame before
+// the tiles. A cell's 8 children are evaluated as 8 interval lanes with the cell's tape;
+// each child gets the tape simplified for its box (runtime/eval/interval.hpp: the same floats as
+// the full program at every point of the box) and its interval [ivlo, ivhi]. Leaves keep
+// their tapes (in `tapes`). Leaf 0 stands for everything outside the root box:
+// the full program, never skipped.
+//
+// Rays locate the leaf of each point (a lane caches its leaf's box), evaluate that leaf's
+// tape, and when the leaf's interval proves it empty (no surface: for a 1-Lipschitz bound,
+// d >= ivlo > 0 everywhere in it) jump to where they leave the box, plus ivlo.
+// The build (split policy, budgets) is in tape_tree.cpp; the lookups are here, inline,
+// because every ray step makes one.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "compiler/bytecode/program.hpp"
+
+namespace sdfc::cpu {
+
+constexpr size_t kTreeMinProgram = 128;  // shorter programs get no tree (lookups would cost more)
+
+struct TapeTree {
+    static constexpr uint32_t kLeafBit = 0x80000000u;
+    struct Node {                 // what a descent reads: 16 bytes
+        float c[3] = {0, 0, 0};   // split point: children with x >= c[0] have bit 0 set, ...
+        uint32_t child = kLeafBit;  // first of 8 children, or kLeafBit | leaf index
+    };
+    struct NodeBox {              // what a climb reads
+        float lo[3] = {0, 0, 0};
+        uint32_t parent = 0;
+        float hi[3] = {0, 0, 0};
+        uint32_t pad = 0;
+        bool holds(float x, float y, float z) const {
+            return x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1] && z >= lo[2] && z <= hi[2];
+        }
+    };
+    struct Leaf {
+        float lo[3], hi[3];  // the box (leaf 0: empty box, so that lanes always re-locate)
+        float ivlo, ivhi;    // the distance over the box
+        const Instr* code;   // its tape (in `tapes`), len instructions, output register out
+        uint32_t len;
+        uint16_t out;
+        uint32_t node;       // its node (leaf 0: the root)
+    };
+    glm::vec3 lo{0}, hi{0};
+    std::vector<Node> nodes;
+    std::vector<NodeBox> boxes_;
+    std::vector<Leaf> leaves;
+    std::vector<std::vector<Instr>> tapes;  // [0]: the full program
+    uint32_t max_regs = 1;
+    uint64_t boxes = 0;
+    bool active = false;
+
+    // Leaf 0 only: the full program everywhere.
+    void init_full(const Program& p) {
+        tapes.assign(1, p.code);
+        constexpr float inf = INFINITY;
+        leaves.assign(1, Leaf{{inf, inf, inf}, {-inf, -inf, -inf}, -inf, inf, tapes[0].data(), static_cast<uint32_t>(tapes[0].size()),
+                              p.outputs.empty() ? uint16_t(0) : p.outputs[0], 0});
+        max_regs = std::max<uint32_t>(p.num_regs, 1);
+        nodes.clear();
+        boxes_.clear();
+        active = false;
+    }
+
+    uint32_t descend(uint32_t n, float x, float y, float z) const {
+        for (;;) {
+            const Node& N = nodes[n];
+            if (N.child & kLeafBit) return N.child & ~kLeafBit;
+            n = N.child + uint32_t(x >= N.c[0]) + 2u * uint32_t(y >= N.c[1]) + 4u * uint32_t(z >= N.c[2]);
+        }
+    }
+    uint32_t locate(float x, float y, float z) const {
+        if (!active || !boxes_[0].holds(x, y, z)) return 0;
+        return descend(0, x, y, z);
+    }
+    // The same, starting from leaf `near` (a neighbour is found by climbing a level or two).
+    uint32_t locate_from(uint32_t near, float x, float y, float z) const {
+        if (!active) return 0;
+        uint32_t n = leaves[near].node;
+        while (n != 0 && !boxes_[n].holds(x, y, z)) n = boxes_[n].parent;
+        if (n == 0 && !boxes_[0].holds(x, y, z)) return 0;
+        return descend(n, x, y, z);
+    }
+};
+
+// Builds the tree over [lo, hi] for output 0 of `p` (call inside the render's task arena;
+// see tape_tree.cpp for the order and the budgets). `lipschitz`: `p` is a 1-Lipschitz
+// distance bound (cells' intervals may be tightened with centre values). `samples`: the
+// image's primary rays, which scale the build's work budget.
+void build_tree(TapeTree& T, const Program& p, glm::vec3 lo, glm::vec3 hi, float time, bool lipschitz, size_t samples);
+
+}  // namespace sdfc::cpu

@@ -1,0 +1,164 @@
+// Worker: one render thread's tracer. It owns one batch Evaluator for the distance tapes
+// and one for the shading program, the lane window and all scratch, built once and reused
+// tile after tile (no allocation once warm), so a tile's result depends only on the tile.
+// Its parts: marcher.cpp (the lane-window loop and every march), shade.cpp (normals,
+// materials, lights, bounces), tile.cpp (one tile from primary rays to pixels).
+#pragma once
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "runtime/cpu/frame.hpp"
+#include "runtime/cpu/lanes.hpp"
+#include "runtime/cpu/rays.hpp"
+#include "runtime/eval/vm.hpp"
+#include "runtime/io/image.hpp"
+
+namespace sdfc::cpu {
+
+constexpr int kConeEvents = 4;  // partial hits a cone composites (cone_march)
+
+class Worker {
+public:
+    explicit Worker(const Frame& f) : f_(f), T_(f.tree), dist_(f.regs) {
+        if (f.has_material) shade_ = std::make_unique<Evaluator>(f.scene->shading);
+        lanes_ = std::make_unique<Lanes>();
+        buckets_ = std::make_unique<Buckets>();
+    }
+
+    // Pixels [x0, x1) x [y0, y1) of img and of the AOV planes that are not null (tile.cpp).
+    void render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* depth, AovPlane* normal, AovPlane* steps);
+
+    RenderStats stats;
+
+private:
+    const Frame& f_;
+    const TapeTree& T_;
+    Evaluator dist_;  // runs tapes of T_ (eval_code) on a register file big enough for all
+    std::unique_ptr<Evaluator> shade_;
+
+    // Scratch, reused tile after tile (no allocation once warm).
+    RaySet rays_, next_, hits_, shadow_;
+    std::vector<float> t_, accum_, px_, py_, pz_, pd_, nx_, ny_, nz_, mat_, vis_, sw_;
+    std::vector<uint8_t> hit_;
+    std::vector<int> steps_;
+    std::vector<float> prim_depth_, prim_steps_, prim_n_, prim_aw_;
+    std::vector<float> ev_t_, ev_w_, trans_;
+    std::vector<int> ev_n_;
+    std::vector<uint32_t> local_, sh_idx_;
+    std::vector<float> lw_, lnx_, lny_, lnz_, ao_, lrad_;
+    uint32_t pleaf_[kWindow];
+    int kind_ = RenderStats::kRays;  // what the distance evaluations are for (stats)
+    alignas(64) float gx_[kBatch], gy_[kBatch], gz_[kBatch];
+
+    std::unique_ptr<Lanes> lanes_;
+    std::unique_ptr<Buckets> buckets_;
+
+    // Distances at n <= kWindow points that all lie in leaf `id`.
+    void eval_leaf(uint32_t id, const float* x, const float* y, const float* z, int n, float* out) {
+        const TapeTree::Leaf& lf = T_.leaves[id];
+        const Instr* code = lf.code;
+        for (int i0 = 0; i0 < n; i0 += kBatch) {
+            const int m = std::min(kBatch, n - i0);
+            dist_.eval_code(code, lf.len, x + i0, y + i0, z + i0, m, f_.time);
+            std::copy_n(dist_.reg_data(lf.out), m, out + i0);
+        }
+        stats.distance_points += static_cast<uint64_t>(n);
+        stats.distance_points_by[kind_] += static_cast<uint64_t>(n);
+        stats.distance_instructions += static_cast<uint64_t>(n) * lf.len;
+    }
+
+    // Distances at n <= kWindow points whose leaves are leaf[0, n): one batch per leaf.
+    void eval_grouped(const float* x, const float* y, const float* z, const uint32_t* leaf, int n, float* out) {
+        bool same = true;
+        for (int i = 1; i < n; ++i) same &= leaf[i] == leaf[0];
+        if (same) return eval_leaf(leaf[0], x, y, z, n, out);
+        Buckets& B = *buckets_;
+        B.build(leaf, n);
+        for (int b = 0; b < B.nb; ++b) {
+            const TapeTree::Leaf& lf = T_.leaves[B.key_of[b]];
+            const Instr* code = lf.code;
+            for (int j0 = B.start[b]; j0 < B.start[b + 1]; j0 += kBatch) {
+                const int m = std::min(kBatch, B.start[b + 1] - j0);
+                const uint16_t* ord = B.order + j0;
+                for (int j = 0; j < m; ++j) gx_[j] = x[ord[j]], gy_[j] = y[ord[j]], gz_[j] = z[ord[j]];
+                dist_.eval_code(code, lf.len, gx_, gy_, gz_, m, f_.time);
+                const float* d = dist_.reg_data(lf.out);
+                for (int j = 0; j < m; ++j) out[ord[j]] = d[j];
+            }
+            const uint64_t cnt = static_cast<uint64_t>(B.start[b + 1] - B.start[b]);
+            stats.distance_points += cnt;
+            stats.distance_points_by[kind_] += cnt;
+            stats.distance_instructions += cnt * lf.len;
+        }
+    }
+
+    // Distance at `count` arbitrary points (each batch grouped by leaf).
+    void eval_points(const float* x, const float* y, const float* z, size_t count, float* out) {
+        if (!T_.active) {
+            for (size_t i = 0; i < count; i += kWindow)
+                eval_leaf(0, x + i, y + i, z + i, static_cast<int>(std::min<size_t>(kWindow, count - i)), out + i);
+            return;
+        }
+        uint32_t prev = 0;
+        for (size_t i0 = 0; i0 < count; i0 += kWindow) {
+            const int m = static_cast<int>(std::min<size_t>(kWindow, count - i0));
+            for (int j = 0; j < m; ++j) {
+                const float px = x[i0 + j], py = y[i0 + j], pz = z[i0 + j];
+                const TapeTree::Leaf& lf = T_.leaves[prev];
+                const bool in = px >= lf.lo[0] && px <= lf.hi[0] && py >= lf.lo[1] && py <= lf.hi[1] && pz >= lf.lo[2] &&
+                                pz <= lf.hi[2];
+                if (!in) prev = T_.locate_from(prev, px, py, pz);
+                pleaf_[j] = prev;
+            }
+            eval_grouped(x + i0, y + i0, z + i0, pleaf_, m, out + i0);
+        }
+    }
+
+    // The lane-window loop and its parts (marcher.cpp).
+    int locate_lanes(Lanes& L, int n);
+    template <class Finish>
+    void retire(Lanes& L, int& n, Finish&& finish);
+    template <class Init, class Update, class Finish, class Empty, class Skip, class Out>
+    void run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish, Empty&& empty, Skip&& skip, Out&& out);
+    bool skip_sphere(Lanes& L, int i, float slo, float te);
+
+    // The marches (marcher.cpp): camera and secondary rays, raw fields, cones, shadows.
+    void march(const RaySet& rs);
+    void march_raw(const RaySet& rs, bool shadow);
+    void cone_march(const RaySet& rs);
+    void shadow_hard(const RaySet& rs);
+    void shadow_soft(const RaySet& rs);
+    float tile_start(int x0, int y0, int x1, int y1);
+
+    // Shading (shade.cpp).
+    void compute_normals(const RaySet& h);
+    void compute_materials(const RaySet& h);
+    void shade(const RaySet& h, int gen, RaySet& next);
+
+    void push_primary(RaySet& rs, const Ray& r, float weight, uint32_t prim, float start) {
+        float tmin = start, tmax = f_.max_dist;
+        f_.clip_ray(r.origin, r.dir, tmin, tmax);
+        rs.push(r.origin, r.dir, tmin, tmax, 0.0f, glm::vec3(weight), prim, false);
+    }
+    void push_secondary(RaySet& rs, const glm::vec3& o, const glm::vec3& d, float path, const glm::vec3& w, uint32_t prim,
+                        bool in) {
+        float tmin = 0.0f, tmax = f_.max_dist;
+        f_.clip_ray(o, d, tmin, tmax);
+        rs.push(o, d, tmin, tmax, path, w, prim, in);
+    }
+    // Adds colour c to the pixel of sample `prim`.
+    void add(uint32_t prim, const glm::vec3& c) {
+        const size_t p = prim / static_cast<uint32_t>(f_.samples);
+        accum_[p * 3 + 0] += c.x;
+        accum_[p * 3 + 1] += c.y;
+        accum_[p * 3 + 2] += c.z;
+    }
+    // The same for shading's contributions (shade.cpp), never inlined: c is rounded to float
+    // before it is added, where an inlined add would let the compiler fuse its last multiply
+    // into the sum (FMA). The pictures have always been made this way; they stay bit-identical.
+    [[gnu::noinline]] void add_shaded(uint32_t prim, const glm::vec3& c) { add(prim, c); }
+};
+
+}  // namespace sdfc::cpu
