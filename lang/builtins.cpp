@@ -2,7 +2,6 @@
 // parameter, and what each builtin builds (a Shape, a modifier, a setting, a math node).
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 #include <fmt/format.h>
 
@@ -14,7 +13,6 @@ namespace {
 
 ParamSpec req(const char* n, PT t) { return ParamSpec{n, t, false, {}}; }
 ParamSpec opt(const char* n, PT t, float a, float b = 0, float c = 0) { return ParamSpec{n, t, true, {a, b, c}}; }
-ParamSpec opt3(const char* n, PT t, float v) { return ParamSpec{n, t, true, {v, v, v}}; }
 
 std::vector<BuiltinInfo> make_table() {
     using P = PT;
@@ -24,57 +22,37 @@ std::vector<BuiltinInfo> make_table() {
     };
     using B = Builtin;
     using K = BuiltinKind;
-    // Primitives
-    add(B::Sphere, "sphere", K::Shape, {req("r", P::Num)});
-    add(B::Box, "box", K::Shape, {req("size", P::NumOrVec3)});
-    add(B::RoundBox, "round_box", K::Shape, {req("size", P::NumOrVec3), req("r", P::Num)});
-    add(B::BoxFrame, "box_frame", K::Shape, {req("size", P::NumOrVec3), req("e", P::Num)});
-    add(B::Torus, "torus", K::Shape, {req("major", P::Num), req("minor", P::Num)});
-    add(B::CappedTorus, "capped_torus", K::Shape, {req("angle", P::Num), req("major", P::Num), req("minor", P::Num)});
-    add(B::Link, "link", K::Shape, {req("length", P::Num), req("major", P::Num), req("minor", P::Num)});
-    add(B::Cylinder, "cylinder", K::Shape, {req("h", P::Num), req("r", P::Num)});
-    add(B::RoundCylinder, "round_cylinder", K::Shape, {req("h", P::Num), req("r", P::Num), req("edge", P::Num)});
-    add(B::Capsule, "capsule", K::Shape, {req("a", P::Vec3), req("b", P::Vec3), req("r", P::Num)});
-    add(B::Cone, "cone", K::Shape, {req("h", P::Num), req("r1", P::Num), opt("r2", P::Num, 0)});
-    add(B::Plane, "plane", K::Shape, {opt("normal", P::Vec3, 0, 1, 0), opt("offset", P::Num, 0)});
-    add(B::Ellipsoid, "ellipsoid", K::Shape, {req("radii", P::NumOrVec3)});
-    add(B::Octahedron, "octahedron", K::Shape, {req("s", P::Num)});
-    add(B::Pyramid, "pyramid", K::Shape, {req("h", P::Num)});
-    add(B::HexPrism, "hex_prism", K::Shape, {req("h", P::Num), req("r", P::Num)});
-    add(B::TriPrism, "tri_prism", K::Shape, {req("h", P::Num), req("r", P::Num)});
-    add(B::Gyroid, "gyroid", K::Shape, {req("period", P::Num), req("thickness", P::Num)});
-    add(B::SchwarzP, "schwarz_p", K::Shape, {req("period", P::Num), req("thickness", P::Num)});
-    add(B::EmptyShape, "empty", K::Shape, {});
-    // Operations
-    for (auto [id, name] : {std::pair{B::Union, "union"}, {B::Intersection, "intersection"}, {B::Difference, "difference"}, {B::Xor, "xor"}})
-        add(id, name, K::Modifier, {});
-    for (auto [id, name] : {std::pair{B::SmoothUnion, "smooth_union"}, {B::SmoothIntersection, "smooth_intersection"},
-                            {B::SmoothDifference, "smooth_difference"}})
-        add(id, name, K::Modifier, {req("k", P::Num)});
-    for (auto [id, name] : {std::pair{B::ChamferUnion, "chamfer_union"}, {B::ChamferIntersection, "chamfer_intersection"},
-                            {B::ChamferDifference, "chamfer_difference"}})
-        add(id, name, K::Modifier, {req("r", P::Num)});
-    for (auto [id, name] : {std::pair{B::StairsUnion, "stairs_union"}, {B::StairsIntersection, "stairs_intersection"},
-                            {B::StairsDifference, "stairs_difference"}})
-        add(id, name, K::Modifier, {req("r", P::Num), req("n", P::Num)});
-    add(B::Translate, "translate", K::Modifier, {req("v", P::Vec3)});
-    add(B::Rotate, "rotate", K::Modifier,
-        {opt("angle", P::Any, 0), opt("axis", P::Vec3, 0, 0, 1), opt("x", P::Num, 0), opt("y", P::Num, 0), opt("z", P::Num, 0)});
-    add(B::Scale, "scale", K::Modifier, {req("s", P::NumOrVec3)});
-    add(B::Mirror, "mirror", K::Modifier, {req("normal", P::Vec3)});
-    add(B::Repeat, "repeat", K::Modifier, {req("period", P::NumOrVec3), opt3("count", P::NumOrVec3, -1)});
-    add(B::PolarRepeat, "polar_repeat", K::Modifier, {req("n", P::Num)});
-    add(B::Symmetry, "symmetry", K::Modifier, {opt("x", P::Bool, 0), opt("y", P::Bool, 0), opt("z", P::Bool, 0)});
-    add(B::Elongate, "elongate", K::Modifier, {req("v", P::NumOrVec3)});
-    add(B::Twist, "twist", K::Modifier, {req("rate", P::Num)});
-    add(B::Bend, "bend", K::Modifier, {req("rate", P::Num)});
-    add(B::Round, "round", K::Modifier, {req("r", P::Num)});
-    add(B::Onion, "onion", K::Modifier, {req("thickness", P::Num)});
-    add(B::Displace, "displace", K::Modifier, {req("amount", P::Num), opt("frequency", P::Num, 1)});
-    add(B::MaterialFn, "material", K::MaterialCtor,
-        {opt("m", P::Material, 0), opt("color", P::Vec3, 0.8f, 0.8f, 0.8f), opt("specular", P::Num, 0.5f),
-         opt("shininess", P::Num, 32), opt("reflect", P::Num, 0), opt("transparency", P::Num, 0), opt("ior", P::Num, 1.5f),
-         opt("emission", P::Vec3, 0, 0, 0)});
+    {
+        // The shapes, from compiler/scene/shapes.def.
+        using namespace param_check;
+        auto shape = [&](Builtin id, const char* name, ShapeKind k, ShapeBuild build, std::vector<ParamSpec> ps) {
+            add(id, name, shape_family(k) == ShapeFamily::Primitive ? K::Shape : K::Modifier, std::move(ps));
+            t.back().shape = k;
+            t.back().build = build;
+        };
+#define SDFC_P(name, type, checks, ...) ParamSpec{#name, P::type, false __VA_OPT__(|| true), {__VA_ARGS__}, checks, true},
+#define SDFC_ARG(name, type, checks, ...) ParamSpec{#name, P::type, false __VA_OPT__(|| true), {__VA_ARGS__}, checks, false},
+#define SDFC_SLOT(name, type)
+#define SDFC_SHAPE(kind, name, family, build, params) shape(B::kind, name, ShapeKind::kind, ShapeBuild::build, {params});
+#define SDFC_INNER_SHAPE(...)
+#include "compiler/scene/shapes.def"
+#undef SDFC_SHAPE
+#undef SDFC_INNER_SHAPE
+#undef SDFC_P
+#undef SDFC_ARG
+#undef SDFC_SLOT
+    }
+    // material(m, then the parameters of compiler/scene/materials.def)
+    std::vector<ParamSpec> mat{opt("m", P::Material, 0)};
+    for (const MatChannelInfo& c : kMatChannelInfo) {
+        if (c.component == 0) {
+            mat.push_back(opt(c.param, P::Num, c.def));
+        } else {
+            mat.back().type = P::Vec3;
+            mat.back().def[c.component] = c.def;
+        }
+    }
+    add(B::MaterialFn, "material", K::MaterialCtor, std::move(mat));
     add(B::Color, "color", K::MaterialCtor, {req("color", P::Vec)});  // named like material's and ambient's
     // Settings
     add(B::Camera, "camera", K::Setting,
@@ -90,16 +68,10 @@ std::vector<BuiltinInfo> make_table() {
          opt("max_distance", P::Num, 100), opt("epsilon", P::Num, 1e-4f), opt("shadows", P::Bool, 1), opt("ao", P::Bool, 1),
          opt("max_bounces", P::Num, 3), opt("aa", P::String, 0)});
     // Math: parameters are checked by call_math.
-    const char* math[] = {"sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sqrt", "pow", "exp", "log", "abs",
-                          "sign", "floor", "ceil", "fract", "mod", "min", "max", "clamp", "mix", "step", "smoothstep",
-                          "length", "distance", "dot", "cross", "normalize", "radians", "degrees", "noise"};
-    for (const char* m : math) {
-        Builtin id{};
-#define SDFC_BUILTIN(i, n, k) if (std::strcmp(n, m) == 0) id = Builtin::i;
+#define SDFC_BUILTIN(i, n, k) \
+    if (K::k == K::Math) add(B::i, n, K::Math, {});
 #include "lang/builtins.def"
 #undef SDFC_BUILTIN
-        add(id, m, K::Math, {});
-    }
     std::sort(t.begin(), t.end(), [](const BuiltinInfo& a, const BuiltinInfo& b) { return a.id < b.id; });
     return t;
 }
@@ -244,28 +216,67 @@ struct Binder {
         if (in.g->is_const(n) && !std::isfinite(in.g->const_value(n)))
             in.fail(loc(i), fmt::format("argument '{}' of {} must be a finite number", info.params[i].name, info.name));
     }
+
+    // A shape's arguments by the Checks column of shapes.def. With `slots` (a primitive):
+    // every stored parameter in order, its default where not given, appended. Without (an
+    // operation, read again when applied): those given that have checks, and a missing
+    // required one. First each argument's own finiteness and sign, then, once all are read,
+    // ranges, whole numbers and directions.
+    void read(std::vector<NodeId>* slots) {
+        using namespace param_check;
+        struct Later { size_t i; Vec3N v; int n; };
+        std::vector<Later> later;
+        for (size_t i = 0; i < info.params.size(); ++i) {
+            const ParamSpec& p = info.params[i];
+            if (slots ? !p.stored : !has(i) || !p.checks) {
+                if (!slots) require(i);
+                continue;
+            }
+            Vec3N v{kNoNode, kNoNode, kNoNode};
+            int n = 1;
+            if (p.type == PT::Num) v[0] = num(i);
+            else if (p.type == PT::Bool) v[0] = boolean(i);
+            else if (p.type == PT::Vec3 || p.type == PT::NumOrVec3) v = vec3(i), n = 3;
+            else in.fail(out.call_loc, fmt::format("internal: {} stores a parameter of no shape type", info.name));
+            for (int k = 0; k < n; ++k) {
+                if (p.checks & Finite) finite(v[k], i);
+                if (p.checks & (NonNeg | Positive)) check_size(v[k], i, p.checks & Positive);
+            }
+            if (slots) slots->insert(slots->end(), v.begin(), v.begin() + n);
+            if (p.checks & (Angle | Whole | Nonzero)) later.push_back({i, v, n});
+        }
+        for (const Later& l : later) {
+            const ParamSpec& p = info.params[l.i];
+            const NodeId x = l.v[0];
+            if (p.checks & Angle) range(x, l.i, 0, 360);
+            if ((p.checks & Whole) && in.g->is_const(x) && in.g->const_value(x) != std::floor(in.g->const_value(x)))
+                in.fail(loc(l.i), fmt::format("argument '{}' of {} must be a whole number", p.name, info.name));
+            if (p.checks & Nonzero) {
+                bool zero = true;
+                for (int k = 0; k < l.n; ++k) zero &= in.g->is_const(l.v[k]) && in.g->const_value(l.v[k]) == 0.0f;
+                if (zero) in.fail(loc(l.i), fmt::format("the {}'s {} must not be zero", info.name, p.name));
+            }
+        }
+    }
 };
 
 void push3(std::vector<NodeId>& v, const Vec3N& a) { v.insert(v.end(), a.begin(), a.end()); }
 
+// material()'s arguments over `base` (or the defaults): parameter 0 is the base itself,
+// then one per script parameter of materials.def, a 3-vector or a size.
 MaterialN material_from(Interp& in, Binder& b, const MaterialN* base) {
-    Graph& g = *in.g;
-    MaterialN m = base ? *base : default_material(g);
-    auto set3 = [&](size_t i, int ch) {
-        if (!b.has(i)) return;
-        Vec3N v = b.vec3(i);
-        for (int k = 0; k < 3; ++k) m[ch + k] = v[k];
-    };
-    auto set1 = [&](size_t i, int ch) {
-        if (b.has(i)) m[ch] = b.size(i);
-    };
-    set3(1, kMatR);
-    set1(2, kMatSpecular);
-    set1(3, kMatShininess);
-    set1(4, kMatReflect);
-    set1(5, kMatTransparency);
-    set1(6, kMatIor);
-    set3(7, kMatEmitR);
+    MaterialN m = base ? *base : default_material(*in.g);
+    size_t i = 0;
+    for (int ch = 0; ch < kMatChannels; ++ch) {
+        if (kMatChannelInfo[ch].component != 0) continue;  // a vector's later components
+        if (!b.has(++i)) continue;
+        if (b.info.params[i].type == PT::Vec3) {
+            Vec3N v = b.vec3(i);
+            for (int k = 0; k < 3; ++k) m[ch + k] = v[k];
+        } else {
+            m[ch] = b.size(i);
+        }
+    }
     return m;
 }
 
@@ -293,53 +304,8 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
     Graph& gr = *g;
     using B = Builtin;
     if (info.kind == BuiltinKind::Shape) {
-        Shape s{ShapeKind::Empty, loc};
-        auto& p = s.params;
-        switch (info.id) {
-            case B::Sphere: s.kind = ShapeKind::Sphere; p = {b.size(0)}; break;
-            case B::Box: s.kind = ShapeKind::Box; push3(p, b.size3(0)); break;
-            case B::RoundBox: s.kind = ShapeKind::RoundBox; push3(p, b.size3(0)); p.push_back(b.size(1)); break;
-            case B::BoxFrame: s.kind = ShapeKind::BoxFrame; push3(p, b.size3(0)); p.push_back(b.size(1)); break;
-            case B::Torus: s.kind = ShapeKind::Torus; p = {b.size(0), b.size(1)}; break;
-            case B::CappedTorus: s.kind = ShapeKind::CappedTorus; p = {b.num(0), b.size(1), b.size(2)}; b.range(p[0], 0, 0, 360); break;
-            case B::Link: s.kind = ShapeKind::Link; p = {b.size(0), b.size(1), b.size(2)}; break;
-            case B::Cylinder: s.kind = ShapeKind::Cylinder; p = {b.size(0), b.size(1)}; break;
-            case B::RoundCylinder: s.kind = ShapeKind::RoundCylinder; p = {b.size(0), b.size(1), b.size(2)}; break;
-            case B::Capsule: {
-                s.kind = ShapeKind::Capsule;
-                Vec3N a = b.vec3(0), c = b.vec3(1);
-                for (NodeId n : a) b.finite(n, 0);
-                for (NodeId n : c) b.finite(n, 1);
-                push3(p, a);
-                push3(p, c);
-                p.push_back(b.size(2));
-                break;
-            }
-            case B::Cone: s.kind = ShapeKind::Cone; p = {b.size(0), b.size(1), b.size(2)}; break;
-            case B::Plane: {
-                s.kind = ShapeKind::Plane;
-                Vec3N n = b.vec3(0);
-                bool zero = true;
-                for (NodeId c : n) {
-                    b.finite(c, 0);
-                    zero &= gr.is_const(c) && gr.const_value(c) == 0.0f;
-                }
-                if (zero) fail(b.loc(0), "the plane's normal must not be zero");
-                push3(p, n);
-                p.push_back(b.num(1));
-                b.finite(p[3], 1);
-                break;
-            }
-            case B::Ellipsoid: s.kind = ShapeKind::Ellipsoid; push3(p, b.size3(0, true)); break;
-            case B::Octahedron: s.kind = ShapeKind::Octahedron; p = {b.size(0)}; break;
-            case B::Pyramid: s.kind = ShapeKind::Pyramid; p = {b.size(0)}; break;
-            case B::HexPrism: s.kind = ShapeKind::HexPrism; p = {b.size(0), b.size(1)}; break;
-            case B::TriPrism: s.kind = ShapeKind::TriPrism; p = {b.size(0), b.size(1)}; break;
-            case B::Gyroid: s.kind = ShapeKind::Gyroid; p = {b.size(0, true), b.size(1)}; break;
-            case B::SchwarzP: s.kind = ShapeKind::SchwarzP; p = {b.size(0, true), b.size(1)}; break;
-            case B::EmptyShape: s.kind = ShapeKind::Empty; break;
-            default: fail(loc, "internal: unknown shape");
-        }
+        Shape s{info.shape, loc};
+        b.read(&s.params);
         return Value::of_shape(make_shape(std::move(s)));
     }
     if (info.kind == BuiltinKind::Modifier) {
@@ -347,43 +313,7 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
         m->id = info.id;
         m->name = info.name;
         m->loc = loc;
-        // Validate eagerly so errors point at the call even before a target is seen.
-        switch (info.id) {
-            case B::SmoothUnion: case B::SmoothIntersection: case B::SmoothDifference:
-            case B::ChamferUnion: case B::ChamferIntersection: case B::ChamferDifference:
-            case B::Round: case B::Onion: case B::Twist: case B::Bend:
-                b.num(0);
-                b.finite(b.num(0), 0);
-                if (info.id != B::Twist && info.id != B::Bend && info.id != B::Round) b.size(0);
-                break;
-            case B::StairsUnion: case B::StairsIntersection: case B::StairsDifference:
-                b.size(0);
-                b.size(1, true);
-                break;
-            case B::Scale: b.size3(0, true); break;
-            case B::PolarRepeat: {
-                NodeId n = b.size(0, true);
-                if (gr.is_const(n) && gr.const_value(n) != std::floor(gr.const_value(n)))
-                    fail(b.loc(0), "argument 'n' of polar_repeat must be a whole number");
-                break;
-            }
-            case B::Mirror: {
-                Vec3N n = b.vec3(0);
-                bool zero = true;
-                for (NodeId c : n) zero &= gr.is_const(c) && gr.const_value(c) == 0.0f;
-                if (zero) fail(b.loc(0), "the mirror's normal must not be zero");
-                break;
-            }
-            case B::Repeat: {
-                b.size3(0);
-                if (b.has(1)) b.size3(1);
-                break;
-            }
-            case B::Displace: b.finite(b.num(0), 0); b.size(1); break;
-            case B::Translate: for (NodeId n : b.vec3(0)) b.finite(n, 0); break;
-            case B::Elongate: b.size3(0); break;
-            default: break;
-        }
+        b.read(nullptr);  // validate eagerly so errors point at the call even before a target is seen
         m->args = std::make_shared<BoundArgs>(std::move(b.out));
         Value v;
         v.t = VT::Modifier;
@@ -526,20 +456,6 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
         }
     };
     switch (m.id) {
-        case B::Union: csg(ShapeKind::Union); break;
-        case B::Intersection: csg(ShapeKind::Intersection); break;
-        case B::Difference: csg(ShapeKind::Difference); break;
-        case B::Xor: csg(ShapeKind::Xor); break;
-        case B::SmoothUnion: csg(ShapeKind::SmoothUnion); s.params = {n0(0, 0)}; break;
-        case B::SmoothIntersection: csg(ShapeKind::SmoothIntersection); s.params = {n0(0, 0)}; break;
-        case B::SmoothDifference: csg(ShapeKind::SmoothDifference); s.params = {n0(0, 0)}; break;
-        case B::ChamferUnion: csg(ShapeKind::ChamferUnion); s.params = {n0(0, 0)}; break;
-        case B::ChamferIntersection: csg(ShapeKind::ChamferIntersection); s.params = {n0(0, 0)}; break;
-        case B::ChamferDifference: csg(ShapeKind::ChamferDifference); s.params = {n0(0, 0)}; break;
-        case B::StairsUnion: csg(ShapeKind::StairsUnion); s.params = {n0(0, 0), n0(1, 1)}; break;
-        case B::StairsIntersection: csg(ShapeKind::StairsIntersection); s.params = {n0(0, 0), n0(1, 1)}; break;
-        case B::StairsDifference: csg(ShapeKind::StairsDifference); s.params = {n0(0, 0), n0(1, 1)}; break;
-        case B::Translate: s.kind = ShapeKind::Translate; push3(s.params, v3(0, 0)); s.children = {target}; break;
         case B::Rotate: {
             s.kind = ShapeKind::Rotate;
             std::array<NodeId, 9> r;
@@ -567,7 +483,6 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
             s.children = {target};
             break;
         }
-        case B::Scale: s.kind = ShapeKind::Scale; push3(s.params, v3(0, 1)); s.children = {target}; break;
         case B::Mirror: {
             s.kind = ShapeKind::Mirror;
             Vec3N n = v3(0, 0);
@@ -590,7 +505,6 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
             s.children = {target};
             break;
         }
-        case B::PolarRepeat: s.kind = ShapeKind::PolarRepeat; s.params = {n0(0, 1)}; s.children = {target}; break;
         case B::Symmetry: {
             s.kind = ShapeKind::Symmetry;
             // LANGUAGE.md writes symmetry(x=true, y=, z=): x is folded unless y or z is named
@@ -601,20 +515,32 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
             s.children = {target};
             break;
         }
-        case B::Elongate: s.kind = ShapeKind::Elongate; push3(s.params, v3(0, 0)); s.children = {target}; break;
-        case B::Twist: s.kind = ShapeKind::Twist; s.params = {n0(0, 0)}; s.children = {target}; break;
-        case B::Bend: s.kind = ShapeKind::Bend; s.params = {n0(0, 0)}; s.children = {target}; break;
-        case B::Round: s.kind = ShapeKind::Round; s.params = {n0(0, 0)}; s.children = {target}; break;
-        case B::Onion: s.kind = ShapeKind::Onion; s.params = {n0(0, 0)}; s.children = {target}; break;
-        case B::Displace: s.kind = ShapeKind::Displace; s.params = {n0(0, 0), n0(1, 1)}; s.children = {target}; break;
         case B::MaterialFn:
         case B::Color:
             s.kind = ShapeKind::Material;
             s.material = m.material;
             s.children = {target};
             break;
-        default:
-            fail(loc, fmt::format("internal: {} is not an operation", m.name));
+        default: {
+            // A Table row of shapes.def: its parameters as given, in order.
+            const BuiltinInfo& info = builtin_info(m.id);
+            if (info.kind != BuiltinKind::Modifier || info.build != ShapeBuild::Table)
+                fail(loc, fmt::format("internal: {} is not an operation", m.name));
+            if (shape_family(info.shape) == ShapeFamily::Csg) {
+                csg(info.shape);
+            } else {
+                s.kind = info.shape;
+                s.children = {target};
+            }
+            for (size_t i = 0; i < info.params.size(); ++i) {
+                const ParamSpec& p = info.params[i];
+                if (!p.stored) continue;
+                if (p.type == PT::Num) s.params.push_back(arg(i) ? num(*arg(i), a.locs[i], "argument") : gr.constant(p.def[0]));
+                else if (p.type == PT::Bool) s.params.push_back(arg(i) ? truth(*arg(i), a.locs[i]) : gr.constant(p.def[0]));
+                else push3(s.params, arg(i) ? vec3(*arg(i), a.locs[i], "argument", true)
+                                            : Vec3N{gr.constant(p.def[0]), gr.constant(p.def[1]), gr.constant(p.def[2])});
+            }
+        }
     }
     return make_shape(std::move(s));
 }

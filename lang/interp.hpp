@@ -33,7 +33,13 @@ struct Env {
     }
 };
 
+// The shapes of compiler/scene/shapes.def that the script names, then lang/builtins.def.
 enum class Builtin : uint16_t {
+#define SDFC_SHAPE(kind, ...) kind,
+#define SDFC_INNER_SHAPE(...)
+#include "compiler/scene/shapes.def"
+#undef SDFC_SHAPE
+#undef SDFC_INNER_SHAPE
 #define SDFC_BUILTIN(id, name, kind) id,
 #include "lang/builtins.def"
 #undef SDFC_BUILTIN
@@ -44,18 +50,29 @@ enum class BuiltinKind { Math, Shape, Modifier, Setting, MaterialCtor };
 // Parameter types of builtins.
 enum class PT { Num, Vec3, NumOrVec3, Vec, Bool, String, Material, Any };
 
+// The checks of a shape's constant arguments (the Checks column of shapes.def).
+namespace param_check {
+enum : uint8_t { None = 0, Finite = 1, NonNeg = 2, Positive = 4, Angle = 8, Whole = 16, Nonzero = 32 };
+}
+
 struct ParamSpec {
     const char* name;
     PT type;
     bool has_default = false;
     std::array<float, 3> def{};
+    uint8_t checks = param_check::None;
+    bool stored = true;  // a shape's: in Shape::params as given (shapes.def's SDFC_P)
 };
+
+enum class ShapeBuild { Table, Custom };
 
 struct BuiltinInfo {
     Builtin id;
     const char* name;
     BuiltinKind kind;
     std::vector<ParamSpec> params;
+    ShapeKind shape = ShapeKind::Empty;  // Shape and Modifier: the kind it makes
+    ShapeBuild build = ShapeBuild::Table;
 };
 
 const BuiltinInfo* find_builtin(std::string_view name);

@@ -67,8 +67,8 @@ CompiledScene compile_scene(const Scene& scene) {
     LoweredScene ls = lower_scene(g, scene);
     cs.distance = codegen(g, {ls.distance}, {"d"});
     std::vector<NodeId> roots{ls.shading_distance};
-    std::vector<std::string> names{"d", "r", "g", "b", "specular", "shininess", "reflect", "transparency", "ior",
-                                   "emit_r", "emit_g", "emit_b"};
+    std::vector<std::string> names{"d"};
+    for (const MatChannelInfo& c : kMatChannelInfo) names.push_back(c.output);
     for (NodeId m : ls.material) roots.push_back(m);
     cs.shading = codegen(g, roots, names);
     check_constants(cs.distance);

@@ -1,6 +1,7 @@
 // Stage 2: lowering a shape tree to IR at a symbolic point. Every primitive and operation
-// of LANGUAGE.md sections 5-6 is one case in lower.cpp, with its formula's source, its
-// parameter layout, and its Lipschitz bound.
+// of LANGUAGE.md sections 5-6 is one row of shapes.def (its parameters) and one function
+// pair in its family's file, shapes_{primitives,csg,modifiers}.cpp (its formula's source,
+// its Lipschitz bound, its bounding box).
 #pragma once
 #include "compiler/scene/scene.hpp"
 

@@ -24,23 +24,41 @@ void set_default_settings(Scene& s) {
 
 MaterialN default_material(Graph& g) {
     MaterialN m;
-    m[kMatR] = m[kMatG] = m[kMatB] = g.constant(0.8f);
-    m[kMatSpecular] = g.constant(0.5f);
-    m[kMatShininess] = g.constant(32.0f);
-    m[kMatReflect] = g.constant(0.0f);
-    m[kMatTransparency] = g.constant(0.0f);
-    m[kMatIor] = g.constant(1.5f);
-    m[kMatEmitR] = m[kMatEmitG] = m[kMatEmitB] = g.constant(0.0f);
+    for (int i = 0; i < kMatChannels; ++i) m[i] = g.constant(kMatChannelInfo[i].def);
     return m;
 }
 
 const char* shape_kind_name(ShapeKind k) {
     switch (k) {
-#define X(n) case ShapeKind::n: return #n;
-        SDFC_SHAPE_KINDS(X)
-#undef X
+#define SDFC_SHAPE(kind, ...) case ShapeKind::kind: return #kind;
+#define SDFC_INNER_SHAPE(kind, ...) case ShapeKind::kind: return #kind;
+#include "compiler/scene/shapes.def"
+#undef SDFC_SHAPE
+#undef SDFC_INNER_SHAPE
     }
     return "?";
+}
+
+ShapeFamily shape_family(ShapeKind k) {
+    switch (k) {
+#define SDFC_SHAPE(kind, name, family, ...) case ShapeKind::kind: return ShapeFamily::family;
+#define SDFC_INNER_SHAPE(kind, family, ...) case ShapeKind::kind: return ShapeFamily::family;
+#include "compiler/scene/shapes.def"
+#undef SDFC_SHAPE
+#undef SDFC_INNER_SHAPE
+    }
+    return ShapeFamily::Primitive;
+}
+
+size_t shape_slots(ShapeKind k) {
+    switch (k) {
+#define SDFC_SHAPE(kind, ...) case ShapeKind::kind: return kind##P::kSlots;
+#define SDFC_INNER_SHAPE(kind, ...) case ShapeKind::kind: return kind##P::kSlots;
+#include "compiler/scene/shapes.def"
+#undef SDFC_SHAPE
+#undef SDFC_INNER_SHAPE
+    }
+    return 0;
 }
 
 std::array<NodeId, 9> rotation_xyz(Graph& g, NodeId ax, NodeId ay, NodeId az) {

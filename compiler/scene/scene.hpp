@@ -16,34 +16,67 @@ namespace sdfc {
 
 using Vec3N = std::array<NodeId, 3>;
 
-// Material channels, in this order, in every material value and material program.
-enum MatChannel { kMatR, kMatG, kMatB, kMatSpecular, kMatShininess, kMatReflect, kMatTransparency, kMatIor,
-                  kMatEmitR, kMatEmitG, kMatEmitB, kMatChannels };
+// Material channels, in this order, in every material value and material program
+// (compiler/scene/materials.def).
+enum MatChannel {
+#define SDFC_MATERIAL(ch, ...) kMat##ch,
+#include "compiler/scene/materials.def"
+#undef SDFC_MATERIAL
+    kMatChannels
+};
+enum class MatClamp { NonNeg, Unit, Shininess, Ior };
+struct MatChannelInfo {
+    const char* output;  // the shading program's output
+    const char* glsl;    // a GLSL local holding it
+    float def;
+    MatClamp clamp;
+    const char* param;   // material()'s parameter
+    int component;       // of that parameter (0, 1, 2 for a 3-vector)
+};
+inline constexpr MatChannelInfo kMatChannelInfo[kMatChannels] = {
+#define SDFC_MATERIAL(ch, output, glsl, def, clamp, param, component) {output, glsl, def, MatClamp::clamp, #param, component},
+#include "compiler/scene/materials.def"
+#undef SDFC_MATERIAL
+};
 using MaterialN = std::array<NodeId, kMatChannels>;
 MaterialN default_material(Graph& g);
 
-#define SDFC_SHAPE_KINDS(X)                                                                     \
-    /* primitives */                                                                            \
-    X(Sphere) X(Box) X(RoundBox) X(BoxFrame) X(Torus) X(CappedTorus) X(Link) X(Cylinder)       \
-    X(RoundCylinder) X(Capsule) X(Cone) X(Plane) X(Ellipsoid) X(Octahedron) X(Pyramid)         \
-    X(HexPrism) X(TriPrism) X(Gyroid) X(SchwarzP) X(Field) X(Empty)                            \
-    /* CSG: children */                                                                         \
-    X(Union) X(Intersection) X(Difference) X(Xor)                                              \
-    X(SmoothUnion) X(SmoothIntersection) X(SmoothDifference)                                   \
-    X(ChamferUnion) X(ChamferIntersection) X(ChamferDifference)                                \
-    X(StairsUnion) X(StairsIntersection) X(StairsDifference)                                   \
-    /* params[0] ? children[0] : children[1], a condition on time alone (GLSL's iTime) */      \
-    X(Choose)                                                                                  \
-    /* modifiers: one child */                                                                  \
-    X(Translate) X(Rotate) X(Scale) X(Mirror) X(Repeat) X(RepeatFinite) X(PolarRepeat)         \
-    X(Symmetry) X(Elongate) X(Twist) X(Bend) X(Round) X(Onion) X(Displace) X(Material)
-
+// Shape kinds, families and parameter slots, from the one table (compiler/scene/shapes.def).
 enum class ShapeKind {
-#define X(n) n,
-    SDFC_SHAPE_KINDS(X)
-#undef X
+#define SDFC_SHAPE(kind, ...) kind,
+#define SDFC_INNER_SHAPE(kind, ...) kind,
+#include "compiler/scene/shapes.def"
+#undef SDFC_SHAPE
+#undef SDFC_INNER_SHAPE
 };
+enum class ShapeFamily { Primitive, Csg, Modifier };
 const char* shape_kind_name(ShapeKind k);
+ShapeFamily shape_family(ShapeKind k);
+size_t shape_slots(ShapeKind k);  // the size of Shape::params
+
+// Where each parameter sits in Shape::params: SphereP::r, RoundBoxP::size (3 slots, then
+// RoundBoxP::r), kSlots in all.
+#define SDFC_SLOTS_Num(n) n,
+#define SDFC_SLOTS_Bool(n) n,
+#define SDFC_SLOTS_Vec3(n) n, n##_y_, n##_z_,
+#define SDFC_SLOTS_NumOrVec3(n) n, n##_y_, n##_z_,
+#define SDFC_SLOTS_Mat3(n) n, n##_01_, n##_02_, n##_10_, n##_11_, n##_12_, n##_20_, n##_21_, n##_22_,
+#define SDFC_P(name, type, ...) SDFC_SLOTS_##type(name)
+#define SDFC_ARG(...)
+#define SDFC_SLOT(name, type) SDFC_SLOTS_##type(name)
+#define SDFC_SHAPE(kind, name, family, build, params) struct kind##P { enum : size_t { params kSlots }; };
+#define SDFC_INNER_SHAPE(kind, family, params) struct kind##P { enum : size_t { params kSlots }; };
+#include "compiler/scene/shapes.def"
+#undef SDFC_SHAPE
+#undef SDFC_INNER_SHAPE
+#undef SDFC_P
+#undef SDFC_ARG
+#undef SDFC_SLOT
+#undef SDFC_SLOTS_Num
+#undef SDFC_SLOTS_Bool
+#undef SDFC_SLOTS_Vec3
+#undef SDFC_SLOTS_NumOrVec3
+#undef SDFC_SLOTS_Mat3
 
 // Axis-aligned bounds of the scene's surface (infinite components for unbounded scenes).
 struct Bounds {
@@ -61,8 +94,9 @@ using FieldFn = std::function<NodeId(Graph&, const Vec3N& p)>;
 struct Shape {
     ShapeKind kind;
     Loc loc;
-    // Parameters, flattened in the order documented in compiler/scene/lower.cpp for each kind
-    // (vectors as consecutive components). Rotate holds a row-major 3x3 matrix.
+    // Parameters, flattened in the order of the kind's row in compiler/scene/shapes.def
+    // (vectors as consecutive components; name them as SphereP::r). Rotate holds a row-major
+    // 3x3 matrix.
     std::vector<NodeId> params;
     std::vector<ShapePtr> children;
     MaterialN material{};  // Material

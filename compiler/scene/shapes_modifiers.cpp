@@ -1,0 +1,355 @@
+// The modifiers of shapes.def (LANGUAGE.md section 6): each one moves the point before its
+// child is lowered (or changes the child's distance after), with the Lipschitz bound that
+// leaves, then its bounding box from the child's. Formulas follow Inigo Quilez and hg_sdf
+// (mercury.sexy/hg_sdf) unless a comment says otherwise.
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "compiler/scene/shape_lowering.hpp"
+
+namespace sdfc::shapes {
+
+namespace {
+
+Lowered child(L& l, const Shape& s, const Vec3N& q, const MaterialN* inherited) {
+    return lower_shape(l.g, *s.children.at(0), q, inherited);
+}
+
+// A child's bounds with `f` applied, unless they are empty or (with `finite`) unbounded.
+template <class F>
+Bounds around(const BoundsIn& b, bool finite, F f) {
+    Bounds c = b.child();
+    if (is_empty(c) || (finite && !c.finite())) return c;
+    return f(c);
+}
+
+float bound_radius(const Bounds& b) {
+    if (!b.finite()) return 10.0f;  // unbounded child: assume the working volume of a scene
+    glm::vec3 e = glm::max(glm::abs(b.lo), glm::abs(b.hi));
+    return glm::length(e);
+}
+
+// Twist and bend multiply the Lipschitz bound by sqrt(1 + (wR)^2) (+ wR for bend), w the
+// rate in radians per unit, R the child's radius. Constant w: folded into lip; otherwise
+// the distance is divided by the bound as an expression.
+Lowered distort_bound(L& l, Lowered r, NodeId w, float R, bool bend) {
+    Graph& g = l.g;
+    if (g.is_const(w)) {
+        float wr = std::fabs(g.const_value(w)) * R;
+        r.lip *= std::sqrt(1.0f + wr * wr) + (bend ? wr : 0.0f);
+        return r;
+    }
+    NodeId wr = l.mul(l.abs(w), l.c(R));
+    NodeId k = l.sqrt(l.add(l.c(1.0f), l.mul(wr, wr)));
+    if (bend) k = l.add(k, wr);
+    r.d = l.div(unit(g, r), k);
+    r.lip = 1.0f;
+    return r;
+}
+
+// Bounds of a child turned about the y axis (axis 1: polar_repeat, twist) or the z axis
+// (axis 2: bend) by any angle: out to its farthest corner across the axis.
+Bounds turned(const Bounds& c, int axis) {
+    const int u = 0, v = axis == 1 ? 2 : 1;
+    float r = std::sqrt(std::max(c.lo[u] * c.lo[u], c.hi[u] * c.hi[u]) + std::max(c.lo[v] * c.lo[v], c.hi[v] * c.hi[v]));
+    Bounds out = c;
+    out.lo[u] = out.lo[v] = -r;
+    out.hi[u] = out.hi[v] = r;
+    return out;
+}
+
+// How many neighbouring cells each side a repeat looks into for a child that reaches out of
+// its own cell (a larger child is cut beyond that).
+constexpr int kRepeatReach = 2;
+
+// The copies of polar_repeat(n) whose child (bounds `b`, copy 0 as given) reaches into
+// sector 0, the one centred on +x (angles atan2(z, x) in [-pi/n, pi/n]): offsets j such
+// that the child turned by j sectors overlaps it. 0 first; at most 2 * kRepeatReach + 1.
+std::vector<int> polar_neighbours(const Bounds& b, float n) {
+    std::vector<int> js{0};
+    if (!(n >= 1.0f) || n != std::floor(n) || !(b.lo.x > -1e29f && b.hi.x < 1e29f && b.lo.z > -1e29f && b.hi.z < 1e29f))
+        return js;
+    const float ang = 2.0f * kPi / n;
+    const int count = int(std::min(n, 1e6f));
+    float a0, a1;  // the child's angular extent
+    if (b.lo.x <= 0 && b.hi.x >= 0 && b.lo.z <= 0 && b.hi.z >= 0) {
+        a0 = -kPi, a1 = kPi;  // around the axis: every direction
+    } else {
+        const float ac = std::atan2(0.5f * (b.lo.z + b.hi.z), 0.5f * (b.lo.x + b.hi.x));
+        a0 = a1 = 0.0f;
+        for (float x : {b.lo.x, b.hi.x})
+            for (float z : {b.lo.z, b.hi.z}) {
+                float d = std::atan2(z, x) - ac;
+                d = d > kPi ? d - 2 * kPi : (d < -kPi ? d + 2 * kPi : d);
+                a0 = std::min(a0, d), a1 = std::max(a1, d);
+            }
+        a0 += ac, a1 += ac;
+    }
+    for (int dj = 1; dj <= count / 2 && int(js.size()) < 2 * kRepeatReach + 1; ++dj)
+        for (int j : {dj, -dj}) {
+            if (j == -dj && 2 * dj == count) continue;  // the same copy as +dj
+            bool hit = false;
+            for (int k = -2; k <= 2 && !hit; ++k) {
+                const float lo = a0 + float(j) * ang + float(k) * 2 * kPi, hi = a1 + float(j) * ang + float(k) * 2 * kPi;
+                hit = lo < 0.5f * ang && hi > -0.5f * ang;
+            }
+            if (hit && int(js.size()) < 2 * kRepeatReach + 1) js.push_back(j);
+        }
+    return js;
+}
+
+// Domain repetition: the point moves into the cell of the nearest copy. A child that
+// reaches out of its cell would be cut at the cell's faces, so the copies of the
+// neighbouring cells that reach into this one are evaluated too (from the child's bounds;
+// none for a child inside its cell, the usual case). `count`: RepeatFinite's slots.
+Lowered repeat(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited, bool finite) {
+    static_assert(size_t(RepeatP::period) == size_t(RepeatFiniteP::period));
+    Graph& g = l.g;
+    auto count = [&](int i) { return P(s, RepeatFiniteP::count + i); };
+    Vec3N per = P3(s, RepeatP::period);
+    const Bounds cb = shape_bounds(g, *s.children.at(0));
+    std::array<NodeId, 3> idx{kNoNode, kNoNode, kNoNode};
+    std::array<int, 3> jlo{0, 0, 0}, jhi{0, 0, 0};
+    for (int i = 0; i < 3; ++i) {
+        if (g.is_const(per[i]) && g.const_value(per[i]) == 0.0f) continue;  // axis left alone
+        idx[i] = g.unary(Op::Floor, l.add(l.div(p[i], per[i]), l.c(0.5f)));
+        if (finite) idx[i] = l.clamp(idx[i], l.neg(count(i)), count(i));
+        if (!g.is_const(per[i]) || !(cb.lo[i] > -1e29f && cb.hi[i] < 1e29f)) continue;
+        const float pe = g.const_value(per[i]), half = 0.5f * pe;  // > 0 (checked by repeat)
+        // Copy j of the neighbours spans [lo + j pe, hi + j pe]: those overlapping
+        // this cell, [-half, half]. At most kRepeatReach each side.
+        // (Clamped as floats first: bounds of 1e28 over a period of 0.01 overflow an int.)
+        const float lo_j = std::floor((-half - cb.hi[i]) / pe) + 1, hi_j = std::ceil((half - cb.lo[i]) / pe) - 1;
+        if (!(pe > 0) || !std::isfinite(lo_j) || !std::isfinite(hi_j)) continue;
+        jlo[i] = int(std::clamp(lo_j, float(-kRepeatReach), 0.0f));
+        jhi[i] = int(std::clamp(hi_j, 0.0f, float(kRepeatReach)));
+    }
+    std::optional<Lowered> acc;  // the copies are one child: one Lipschitz bound
+    for (int jx = jlo[0]; jx <= jhi[0]; ++jx)
+        for (int jy = jlo[1]; jy <= jhi[1]; ++jy)
+            for (int jz = jlo[2]; jz <= jhi[2]; ++jz) {
+                const int j[3] = {jx, jy, jz};
+                Vec3N q = p;
+                for (int i = 0; i < 3; ++i) {
+                    if (idx[i] == kNoNode) continue;
+                    NodeId c = idx[i];
+                    if (j[i] != 0) {
+                        c = l.add(c, l.c(float(j[i])));
+                        if (finite) c = l.clamp(c, l.neg(count(i)), count(i));
+                    }
+                    q[i] = l.sub(p[i], l.mul(per[i], c));
+                }
+                Lowered r = child(l, s, q, inherited);
+                acc = acc ? nearer(l, *acc, r, inherited) : r;
+            }
+    return *acc;
+}
+
+}  // namespace
+
+Lowered lower_Translate(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    return child(l, s, l.sub3(p, P3(s, TranslateP::v)), inherited);
+}
+Bounds bounds_Translate(const BoundsIn& b) {
+    return around(b, false, [&](const Bounds& c) { return Bounds{c.lo + b.v3(TranslateP::v), c.hi + b.v3(TranslateP::v)}; });
+}
+
+namespace {
+// The box around a child's box mapped by m (column-major, glm's).
+Bounds mapped(const BoundsIn& b, const glm::mat3& m) {
+    Bounds c = b.child();
+    if (is_empty(c) || !c.finite()) return is_empty(c) ? c : infinite();
+    Bounds out = empty();
+    for (int i = 0; i < 8; ++i) {
+        glm::vec3 corner{i & 1 ? c.hi.x : c.lo.x, i & 2 ? c.hi.y : c.lo.y, i & 4 ? c.hi.z : c.lo.z};
+        glm::vec3 q = m * corner;
+        out = join(out, Bounds{q, q});
+    }
+    return out;
+}
+}  // namespace
+
+Lowered lower_Rotate(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    // The shape turns by R, so the point turns back by R^T.
+    const NodeId* m = &s.params.at(RotateP::m);
+    Vec3N q;
+    for (int i = 0; i < 3; ++i) q[i] = l.add(l.add(l.mul(m[i], p[0]), l.mul(m[3 + i], p[1])), l.mul(m[6 + i], p[2]));
+    return child(l, s, q, inherited);
+}
+Bounds bounds_Rotate(const BoundsIn& b) {
+    glm::mat3 m(1.0f);
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) m[c][r] = b.v.at(RotateP::m + r * 3 + c);
+    return mapped(b, m);
+}
+
+Lowered lower_Scale(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    Vec3N sc = P3(s, ScaleP::s);
+    Lowered r = child(l, s, {l.div(p[0], sc[0]), l.div(p[1], sc[1]), l.div(p[2], sc[2])}, inherited);
+    // d(p/s)*min(s) is a bound for any scale; exact when uniform.
+    r.d = l.mul(r.d, l.mn(sc[0], l.mn(sc[1], sc[2])));
+    return r;
+}
+Bounds bounds_Scale(const BoundsIn& b) {
+    return around(b, true, [&](const Bounds& c) { return Bounds{c.lo * b.v3(ScaleP::s), c.hi * b.v3(ScaleP::s)}; });
+}
+
+Lowered lower_Mirror(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    Vec3N n = P3(s, MirrorP::normal);  // unit (lang/builtins.cpp divides by its length)
+    NodeId k = l.mul(l.c(2), l.dot3(p, n));
+    return child(l, s, {l.sub(p[0], l.mul(k, n[0])), l.sub(p[1], l.mul(k, n[1])), l.sub(p[2], l.mul(k, n[2]))}, inherited);
+}
+Bounds bounds_Mirror(const BoundsIn& b) {
+    glm::vec3 n = b.v3(MirrorP::normal);
+    return mapped(b, glm::mat3(1.0f) - 2.0f * glm::outerProduct(n, n));
+}
+
+Lowered lower_Repeat(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    return repeat(l, s, p, inherited, false);
+}
+Bounds bounds_Repeat(const BoundsIn& b) {
+    Bounds c = b.child();
+    for (int i = 0; i < 3; ++i)
+        if (b.v[RepeatP::period + i] != 0.0f) { c.lo[i] = -kInf; c.hi[i] = kInf; }
+    return c;
+}
+
+Lowered lower_RepeatFinite(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    return repeat(l, s, p, inherited, true);
+}
+Bounds bounds_RepeatFinite(const BoundsIn& b) {
+    return around(b, false, [&](Bounds c) {
+        for (int i = 0; i < 3; ++i) {
+            float e = std::fabs(b.v[RepeatFiniteP::period + i]) * std::fabs(b.v[RepeatFiniteP::count + i]);
+            if (c.lo[i] > -kInf * 0.1f) c.lo[i] -= e;
+            if (c.hi[i] < kInf * 0.1f) c.hi[i] += e;
+        }
+        return c;
+    });
+}
+
+Lowered lower_PolarRepeat(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    // hg_sdf pModPolar around y; copy 0 points along +x. As for repeat, the copies of the
+    // neighbouring sectors that reach into this one are evaluated too.
+    Graph& g = l.g;
+    NodeId n = P(s, PolarRepeatP::n);
+    NodeId ang = l.div(l.c(2 * kPi), n);
+    NodeId a = l.add(g.binary(Op::Atan2, p[2], p[0]), l.mul(ang, l.c(0.5f)));
+    NodeId r = l.len2(p[0], p[2]);
+    a = l.sub(g.binary(Op::Mod, a, ang), l.mul(ang, l.c(0.5f)));
+    std::vector<int> js{0};
+    if (g.is_const(n)) js = polar_neighbours(shape_bounds(g, *s.children.at(0)), g.const_value(n));
+    std::optional<Lowered> acc;
+    for (int j : js) {
+        NodeId aj = j == 0 ? a : l.sub(a, l.mul(ang, l.c(float(j))));
+        Lowered c = child(l, s, {l.mul(g.unary(Op::Cos, aj), r), p[1], l.mul(g.unary(Op::Sin, aj), r)}, inherited);
+        acc = acc ? nearer(l, *acc, c, inherited) : c;
+    }
+    return *acc;
+}
+Bounds bounds_PolarRepeat(const BoundsIn& b) {
+    return around(b, true, [](const Bounds& c) { return turned(c, 1); });
+}
+
+Lowered lower_Symmetry(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    Graph& g = l.g;
+    Vec3N q = p;
+    for (int i = 0; i < 3; ++i) {
+        const NodeId fold = P(s, SymmetryP::x + i);
+        if (!(g.is_const(fold) && g.const_value(fold) == 0.0f)) q[i] = l.sel(fold, l.abs(p[i]), p[i]);
+    }
+    return child(l, s, q, inherited);
+}
+Bounds bounds_Symmetry(const BoundsIn& b) {
+    return around(b, false, [&](Bounds c) {
+        for (int i = 0; i < 3; ++i)
+            if (b.v[SymmetryP::x + i] != 0.0f) {
+                float e = std::max(std::fabs(c.lo[i]), std::fabs(c.hi[i]));
+                c.lo[i] = -e;
+                c.hi[i] = e;
+            }
+        return c;
+    });
+}
+
+Lowered lower_Elongate(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    // Quilez's elongation, basic form: q = p - clamp(p, -h, h), h = v / 2.
+    Vec3N h = P3(s, ElongateP::v);
+    Vec3N q;
+    for (int i = 0; i < 3; ++i) {
+        NodeId hh = l.mul(h[i], l.c(0.5f));
+        q[i] = l.sub(p[i], l.clamp(p[i], l.neg(hh), hh));
+    }
+    return child(l, s, q, inherited);
+}
+Bounds bounds_Elongate(const BoundsIn& b) {
+    return around(b, false, [&](const Bounds& c) {
+        glm::vec3 h = glm::abs(b.v3(ElongateP::v)) * 0.5f;
+        return Bounds{c.lo - h, c.hi + h};
+    });
+}
+
+Lowered lower_Twist(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    Graph& g = l.g;
+    NodeId w = l.mul(P(s, TwistP::rate), l.c(kDeg));
+    NodeId a = l.mul(w, p[1]);
+    NodeId cs = g.unary(Op::Cos, a), sn = g.unary(Op::Sin, a);
+    Lowered r = child(l, s, {l.sub(l.mul(cs, p[0]), l.mul(sn, p[2])), p[1], l.add(l.mul(sn, p[0]), l.mul(cs, p[2]))}, inherited);
+    // |J| <= sqrt(1 + (w R)^2) with R the child's radius about the axis. A rate that
+    // depends on time (GLSL) divides by the same bound computed at run time.
+    return distort_bound(l, r, w, bound_radius(shape_bounds(g, *s.children[0])), false);
+}
+Bounds bounds_Twist(const BoundsIn& b) {
+    return around(b, true, [](const Bounds& c) { return turned(c, 1); });
+}
+
+Lowered lower_Bend(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    Graph& g = l.g;
+    NodeId w = l.mul(P(s, BendP::rate), l.c(kDeg));
+    NodeId a = l.mul(w, p[0]);
+    NodeId cs = g.unary(Op::Cos, a), sn = g.unary(Op::Sin, a);
+    Lowered r = child(l, s, {l.sub(l.mul(cs, p[0]), l.mul(sn, p[1])), l.add(l.mul(sn, p[0]), l.mul(cs, p[1])), p[2]}, inherited);
+    return distort_bound(l, r, w, bound_radius(shape_bounds(g, *s.children[0])), true);
+}
+Bounds bounds_Bend(const BoundsIn& b) {
+    return around(b, true, [](const Bounds& c) { return turned(c, 2); });
+}
+
+Lowered lower_Round(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    Lowered r = child(l, s, p, inherited);
+    r.d = l.sub(unit(l.g, r), P(s, RoundP::r));
+    r.lip = 1.0f;
+    return r;
+}
+Bounds bounds_Round(const BoundsIn& b) { return grow(b.child(), b.f(RoundP::r)); }
+
+Lowered lower_Onion(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    Lowered r = child(l, s, p, inherited);
+    r.d = l.sub(l.abs(unit(l.g, r)), P(s, OnionP::thickness));
+    r.lip = 1.0f;
+    return r;
+}
+Bounds bounds_Onion(const BoundsIn& b) { return grow(b.child(), b.f(OnionP::thickness)); }
+
+Lowered lower_Displace(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    Graph& g = l.g;
+    Lowered r = child(l, s, p, inherited);
+    NodeId amt = P(s, DisplaceP::amount), f = P(s, DisplaceP::frequency);
+    NodeId n = g.ternary(Op::Noise3, l.mul(p[0], f), l.mul(p[1], f), l.mul(p[2], f));
+    r.d = l.add(unit(g, r), l.mul(amt, n));
+    float a = g.is_const(amt) ? std::fabs(g.const_value(amt)) : 1.0f;
+    float fr = g.is_const(f) ? std::fabs(g.const_value(f)) : 1.0f;
+    r.lip = 1.0f + a * fr * om::kNoiseLipschitz;
+    return r;
+}
+Bounds bounds_Displace(const BoundsIn& b) { return grow(b.child(), b.f(DisplaceP::amount) * 1.5f); }
+
+Lowered lower_Material(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    // The inner material wins: this one only reaches shapes that have none of their own,
+    // so it replaces what the enclosing scope passed down.
+    return child(l, s, p, inherited ? &s.material : nullptr);
+}
+Bounds bounds_Material(const BoundsIn& b) { return b.child(); }
+
+}  // namespace sdfc::shapes
