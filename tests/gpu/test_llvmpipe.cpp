@@ -11,8 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "gles.hpp"
-#include "gpu_common.hpp"
+#include "shadertoy.hpp"
 
 namespace {
 
@@ -21,30 +20,6 @@ using namespace sdfc::gpu_test;
 
 constexpr int kWidth = 160, kHeight = 90;
 constexpr double kMinPsnr = 40.0;
-
-// What shadertoy.com puts around a shader (GLSL ES 3.00).
-std::string shadertoy_wrap(const std::string& code) {
-    return "#version 300 es\nprecision highp float;\nprecision highp int;\n"
-           "uniform vec3 iResolution;\nuniform float iTime;\nuniform vec4 iMouse;\nout vec4 sdf_shadertoy_out;\n" +
-           code + "\nvoid main() { mainImage(sdf_shadertoy_out, gl_FragCoord.xy); }\n";
-}
-
-// Draws `frag` with Shadertoy's uniforms at kWidth x kHeight; fills `out` (row 0 at the top).
-std::string draw_shadertoy(Gles& gles, const std::string& frag, Rgb8& out) {
-    std::vector<uint8_t> rgba;
-    const std::string err = gles.draw(frag, kWidth, kHeight, rgba, [](GLuint prog) {
-        glUniform3f(glGetUniformLocation(prog, "iResolution"), kWidth, kHeight, 1.0f);
-        glUniform1f(glGetUniformLocation(prog, "iTime"), 0.0f);
-        glUniform4f(glGetUniformLocation(prog, "iMouse"), 0.0f, 0.0f, 0.0f, 0.0f);
-    });
-    if (!err.empty()) return err;
-    out = Rgb8{kWidth, kHeight, std::vector<uint8_t>(static_cast<size_t>(kWidth) * kHeight * 3)};
-    for (int y = 0; y < kHeight; ++y)
-        for (int x = 0; x < kWidth; ++x)
-            for (int c = 0; c < 3; ++c)
-                out.px[(static_cast<size_t>(y) * kWidth + x) * 3 + c] = rgba[(static_cast<size_t>(kHeight - 1 - y) * kWidth + x) * 4 + c];
-    return "";
-}
 
 }  // namespace
 
@@ -70,7 +45,7 @@ TEST_CASE("every example drawn by llvmpipe from the Shadertoy GLSL matches the C
         const Rgb8 cpu = cpu_render(path, kWidth, kHeight);
         auto t1 = std::chrono::steady_clock::now();
         Rgb8 gpu;
-        const std::string err = draw_shadertoy(gles, shadertoy_wrap(glsl_of(path, GlslTarget::Shadertoy)), gpu);
+        const std::string err = draw_shadertoy(gles, shadertoy_wrap(glsl_of(path, GlslTarget::Shadertoy)), kWidth, kHeight, gpu);
         auto t2 = std::chrono::steady_clock::now();
         REQUIRE(err == "");
         const double p = psnr(cpu, gpu);
