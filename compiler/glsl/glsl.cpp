@@ -155,11 +155,16 @@ Parts generate(const Scene& scene) {
     c += fmt::format("const vec3 SDF_SOLID_LO = {};\nconst vec3 SDF_SOLID_HI = {};\n", vec3_lit(plan.solid_lo.x, plan.solid_lo.y, plan.solid_lo.z),
                      vec3_lit(plan.solid_hi.x, plan.solid_hi.y, plan.solid_hi.z));
     c += fmt::format("const float SDF_RELAX = {};  // over-relaxed sphere tracing\n", literal(plan.relax));
+    c += fmt::format("const bool SDF_PREMARCH = {};  // primary rays start where their tile's cone march ends\n",
+                     plan.premarch ? "true" : "false");
     c += fmt::format("const bool SDF_RAW = {};  // a raw field (.vm model): no distance bound, sign-change marching\n"
                      "const float SDF_RAW_INV_LIPSCHITZ = {};\nconst float SDF_RAW_MAX_STEP = {};\n",
                      plan.raw ? "true" : "false", literal(1.0f / plan.raw_lipschitz), literal(plan.raw_max_step));
     c += fmt::format("const int SDF_NUM_LIGHTS = {};\nconst bool SDF_DEFAULT_LIGHTS = {};  // the script has no light: the default rig\n\n",
                      nlights, scene.lights.empty() ? "true" : "false");
+    c += "\n// ---- the per-ray rules both renderers share (compiler/render/rules.h) ----\n";
+    c += glsl::shared_rules_glsl(glsl::kSharedRules);
+    c += "\n";
     c += glsl::kRendererHead;
     if (glsl::uses_op(dist, Op::Noise3) || glsl::uses_op(mat, Op::Noise3) || glsl::uses_op(set, Op::Noise3)) {
         c += "\n// Gradient noise, bit for bit the CPU's (compiler/ir/op_math.hpp).\n";
@@ -210,8 +215,8 @@ Parts generate(const Scene& scene) {
             l.push_back("vec3 fwd = normalize(sdf_cam_target - sdf_cam_position);");
             l.push_back("vec3 right = normalize(cross(fwd, sdf_cam_up));");
             l.push_back("vec3 up = normalize(sdf_cam_up);");
-            l.push_back("sdf_lights[0] = SdfLight(true, vec3(0.0), normalize(fwd + 0.6 * right - 1.2 * up), vec3(1.0, 0.97, 0.92), 1.0, 0.0);");
-            l.push_back("sdf_lights[1] = SdfLight(true, vec3(0.0), normalize(fwd - 0.8 * right - 0.3 * up), vec3(0.55, 0.6, 0.7), 0.35, 0.0);");
+            l.push_back("sdf_lights[0] = SdfLight(true, vec3(0.0), sdf_key_light_dir(fwd, right, up), sdf_key_light_color(), sdf_key_light_intensity(), 0.0);");
+            l.push_back("sdf_lights[1] = SdfLight(true, vec3(0.0), sdf_fill_light_dir(fwd, right, up), sdf_fill_light_color(), sdf_fill_light_intensity(), 0.0);");
         }
         for (size_t i = 0; i < lights.size(); ++i) {
             const size_t b = 17 + 8 * i;

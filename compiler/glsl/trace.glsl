@@ -1,39 +1,21 @@
 //! The last part of the renderer: normals, materials, then sdf_trace (all rays of a sample as one
 //! state machine around a single map() call) and sdf_render, which the entry points call.
 
-// Tetrahedron technique: the normal is sum_k k * map(p + e * k).
-vec3 sdf_tetra(int k) {
-    return k == 0 ? vec3(1.0, -1.0, -1.0) : (k == 1 ? vec3(-1.0, -1.0, 1.0) : (k == 2 ? vec3(-1.0, 1.0, -1.0) : vec3(1.0)));
-}
-
-// The material at p, sanitised (no NaN/inf, sensible ranges).
+// The material at p, made safe to shade with (the rules of compiler/render/rules.h).
 Material sdf_surface(vec3 p) {
     Material m = sdf_material(p);
-    m.color = vec3(sdf_nonneg(m.color.x), sdf_nonneg(m.color.y), sdf_nonneg(m.color.z));
+    m.color = sdf_nonneg3(m.color);
     m.specular = sdf_nonneg(m.specular);
-    m.emission = vec3(sdf_nonneg(m.emission.x), sdf_nonneg(m.emission.y), sdf_nonneg(m.emission.z));
-    m.shininess = sdf_finite(m.shininess) ? clamp(m.shininess, 0.0, 1e4) : 32.0;
+    m.emission = sdf_nonneg3(m.emission);
+    m.shininess = sdf_safe_shininess(m.shininess);
     m.reflectance = sdf_clamp01(m.reflectance);
     m.transparency = sdf_clamp01(m.transparency);
-    m.ior = (sdf_finite(m.ior) && m.ior > 1e-3) ? m.ior : 1.5;
+    m.ior = sdf_safe_ior(m.ior);
     return m;
 }
 
-float sdf_schlick(float cos_theta, float ior) {
-    float r0 = (ior - 1.0) / (ior + 1.0);
-    r0 *= r0;
-    float m = 1.0 - sdf_clamp01(cos_theta);
-    float m2 = m * m;
-    return r0 + (1.0 - r0) * m2 * m2 * m;
-}
-
-float sdf_pow(float x, float y) {
-    if (y == 0.0) return 1.0;
-    return x > 0.0 ? pow(x, y) : 0.0;
-}
-
-// Settings the CPU compiler resolves (compiler/bytecode/compile.cpp): light directions normalised,
-// colours of ambient and background made finite and non-negative.
+// Settings the CPU resolves in compiler/bytecode/compile.cpp and compiler/render/plan.cpp: light
+// directions normalised, colours of ambient and background made finite and non-negative.
 void sdf_init_scene() {
     if (!SDF_DEFAULT_LIGHTS) {
         for (int i = 0; i < SDF_NUM_LIGHTS; ++i)
@@ -42,8 +24,8 @@ void sdf_init_scene() {
                 sdf_lights[i].direction = length(d) > 0.0 ? normalize(d) : vec3(0.0, -1.0, 0.0);
             }
     }
-    sdf_ambient = vec3(sdf_nonneg(sdf_ambient.x), sdf_nonneg(sdf_ambient.y), sdf_nonneg(sdf_ambient.z));
-    sdf_background = vec3(sdf_nonneg(sdf_background.x), sdf_nonneg(sdf_background.y), sdf_nonneg(sdf_background.z));
+    sdf_ambient = sdf_nonneg3(sdf_ambient);
+    sdf_background = sdf_nonneg3(sdf_background);
 }
 
 // A ray waiting to be traced (or, with known = true, a hit already found at thit).
@@ -61,10 +43,11 @@ const int SDF_ST_CONE = 1;    // the cone of a primary ray (aa = "cone")
 const int SDF_ST_NORMAL = 2;  // the 4 taps of a hit's normal
 const int SDF_ST_AO = 3;      // the 5 ambient-occlusion taps
 const int SDF_ST_SHADOW = 4;  // a shadow ray toward light `li`
+const int SDF_ST_PRE = 5;     // the tile's pre-march (sdf_setup_premarch)
 // ... and those that do not.
-const int SDF_ST_POP = 5;     // next ray from the stack
-const int SDF_ST_LIGHT = 6;   // set up light `li`
-const int SDF_ST_DONE = 7;
+const int SDF_ST_POP = 6;     // next ray from the stack
+const int SDF_ST_LIGHT = 7;   // set up light `li`
+const int SDF_ST_DONE = 8;
 
 // One primary sample of weight w0: the first hit, then mirror/glass bounces depth first from
 // an explicit stack (GLSL has no recursion). Everything the CPU does per ray (marching,
@@ -74,7 +57,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
     vec3 acc = vec3(0.0);
     SdfRay stack[SDF_STACK];
     int sp = 0;
-    float tmin = 0.0, tmax = SDF_MAX_DIST;
+    float tmin = SDF_CONE || SDF_RAW ? 0.0 : max(sdf_start, 0.0), tmax = SDF_MAX_DIST;
     sdf_clip_ray(O, D, tmin, tmax);
     SdfRay r = SdfRay(O, D, vec3(w0), tmin, tmax, 0.0, 0.0, false, false, 0);
     int mode = SDF_ST_POP;
@@ -103,6 +86,9 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
             acc += sdf_background * w0;
             mode = SDF_ST_DONE;
         }
+    } else if (SDF_PREMARCH && sdf_start < 0.0) {
+        mode = SDF_ST_PRE;  // then this ray, from where the pre-march ends
+        t = 0.0;
     } else {
         stack[sp++] = r;
     }
@@ -136,7 +122,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
                 P = r.o + r.d * t;
                 path = r.t0 + t;
                 Dr = r.d;
-                e = max(sdf_thr(path), 2e-5 * (1.0 + sdf_maxabs3(P)));
+                e = sdf_normal_eps(SDF_EPSILON, P, path);
                 g = vec3(0.0);
                 break;
             }
@@ -159,23 +145,20 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
                     dist = length(L);
                     skip = !(dist > 1e-6);
                     L /= dist;
-                    falloff = 1.0 / (dist * dist);
+                    falloff = sdf_falloff(dist);
                 }
                 float ndl = dot(Nf, L);
                 if (skip || !(ndl > 0.0)) {
                     ++li;
                     continue;
                 }
-                vec3 H = normalize(L - Dr);
-                float ndh = max(dot(Nf, H), 0.0);
-                float spec = m.specular > 0.0 ? m.specular * sdf_pow(ndh, m.shininess) : 0.0;
-                sc = lw * radiance * falloff * (m.color * ndl + spec);
+                sc = lw * radiance * falloff * sdf_blinn_phong(Nf, L, -Dr, m.color, m.specular, m.shininess);
                 if (!SDF_SHADOWS) {
                     acc += sc;
                     ++li;
                     continue;
                 }
-                float bias = sdf_bias(P, path);
+                float bias = sdf_bias(SDF_EPSILON, P, path);
                 so = P + Nf * bias;
                 sdir = L;
                 float a0 = bias;  // (as runtime/cpu/tracer.cpp: edges do not shadow themselves)
@@ -203,15 +186,26 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
         vec3 pos = mode == SDF_ST_MARCH ? r.o + t * r.d
                  : mode == SDF_ST_CONE ? O + t * D
                  : mode == SDF_ST_NORMAL ? P + e * sdf_tetra(k)
-                 : mode == SDF_ST_AO ? P + Nf * (0.01 + 0.12 * float(k) / 4.0)
+                 : mode == SDF_ST_AO ? P + Nf * sdf_ao_offset(k)
+                 : mode == SDF_ST_PRE ? sdf_pre_o + t * sdf_pre_d
                  : so + t * sdir;
         float dist = map(pos);
         ++steps;
 
         if (mode == SDF_ST_MARCH) {
-            bool hit;
-            bool done = SDF_RAW ? sdf_raw_step(r.inside ? -dist : dist, r.t0, r.tmax, false, steps, t, prev, lo, hi, bisect, hit)
-                                : sdf_relaxed_step(r.inside ? -dist : dist, r.t0, r.tmax, false, steps, t, om, pr, sl, hit);
+            bool hit = false, done;
+            float s = r.inside ? -dist : dist;
+            if (SDF_RAW) {
+                done = sdf_raw_step(s, r.t0, r.tmax, false, steps, SDF_MAX_STEPS, SDF_EPSILON, sdf_cam.foot_base, sdf_cam.foot_slope,
+                                    SDF_RAW_INV_LIPSCHITZ, SDF_RAW_MAX_STEP, t, prev, lo, hi, bisect, hit);
+            } else {
+                float last;
+                done = sdf_relaxed_step(s, r.t0, r.tmax, false, steps, SDF_MAX_STEPS, SDF_EPSILON, t, om, pr, sl, last);
+                if (done) {
+                    hit = sdf_relaxed_hit(last, r.t0 + t, steps, SDF_MAX_STEPS, SDF_EPSILON, sdf_cam.foot_base, sdf_cam.foot_slope);
+                    t = sdf_hit_t(t, last, hit);
+                }
+            }
             if (done) {
                 if (hit) {
                     mode = SDF_ST_NORMAL;
@@ -225,9 +219,9 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
             // Cone tracing (primary rays only): where the ray passes an edge (d < the pixel
             // footprint without hitting) the closest approach is a partial hit of coverage
             // 1 - d/r; up to 4 are composited front to back, the final hit takes the rest.
-            float radius = max(sdf_footprint(t), 1e-30);
+            float radius = max(sdf_footprint(sdf_cam.foot_base, sdf_cam.foot_slope, t), 1e-30);
             bool done = false, hit = false;
-            if (dist < sdf_thr(t)) {
+            if (dist < sdf_thr(SDF_EPSILON, t)) {
                 done = hit = true;
             } else if (isnan(dist)) {
                 done = true;
@@ -267,12 +261,11 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
             g += sdf_tetra(k) * dist;
             if (++k < 4) continue;
             k = 0;
-            float len2 = dot(g, g);
-            vec3 N = (len2 > 1e-30 && sdf_finite(len2)) ? g * (1.0 / sqrt(len2)) : -Dr;  // flat or broken: face the viewer
+            vec3 N = sdf_normal(g, Dr);
             Nf = dot(Dr, N) > 0.0 ? -N : N;  // facing the incoming ray
             m = sdf_surface(P);
             bool can_spawn = r.gen < SDF_MAX_BOUNCES;
-            float bias = sdf_bias(P, path);
+            float bias = sdf_bias(SDF_EPSILON, P, path);
             mode = SDF_ST_POP;
             if (r.inside) {
                 // Leaving a transparent solid: refract out, reflect back in (Fresnel / TIR).
@@ -336,18 +329,32 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
                 }
             }
         } else if (mode == SDF_ST_AO) {
-            float s = 0.01 + 0.12 * float(k) / 4.0;
-            if (dist < s) occ += (s - dist) * sca;  // (NaN adds nothing)
-            sca *= 0.95;
+            sdf_ao_tap(dist, k, occ, sca);
             if (++k < 5) continue;
             k = 0;
-            acc += lw * m.color * sdf_ambient * sdf_clamp01(1.0 - 3.0 * occ);
+            acc += lw * m.color * sdf_ambient * sdf_ao_visibility(occ);
             mode = SDF_ST_LIGHT;
+        } else if (mode == SDF_ST_PRE) {
+            bool more = sdf_premarch_step(dist, sdf_pre_r, SDF_EPSILON, t);
+            if (!more || steps >= 32 || !(t < SDF_MAX_DIST)) {
+                sdf_start = t;
+                float a0 = t, b0 = SDF_MAX_DIST;
+                sdf_clip_ray(O, D, a0, b0);
+                stack[sp++] = SdfRay(O, D, vec3(w0), a0, b0, 0.0, 0.0, false, false, 0);
+                mode = SDF_ST_POP;
+            }
         } else {  // SDF_ST_SHADOW
             bool hit = false, done;
-            if (SDF_RAW) done = sdf_raw_step(dist, path, stmax, true, steps, t, prev, lo, hi, bisect, hit);
-            else if (soft) done = sdf_soft_step(dist, path, stmax, sw, steps, t, res, prev, om, pr, sl);
-            else done = sdf_relaxed_step(dist, path, stmax, true, steps, t, om, pr, sl, hit);
+            if (SDF_RAW) {
+                done = sdf_raw_step(dist, path, stmax, true, steps, SDF_MAX_STEPS, SDF_EPSILON, sdf_cam.foot_base, sdf_cam.foot_slope,
+                                    SDF_RAW_INV_LIPSCHITZ, SDF_RAW_MAX_STEP, t, prev, lo, hi, bisect, hit);
+            } else if (soft) {
+                done = sdf_soft_step(dist, path, stmax, sw, steps, SDF_MAX_STEPS, SDF_EPSILON, t, res, prev, om, pr, sl);
+            } else {
+                float last;
+                done = sdf_relaxed_step(dist, path, stmax, true, steps, SDF_MAX_STEPS, SDF_EPSILON, t, om, pr, sl, last);
+                if (done) hit = sdf_relaxed_hit(last, path + t, steps, SDF_MAX_STEPS, SDF_EPSILON, sdf_cam.foot_base, sdf_cam.foot_slope);
+            }
             if (done) {
                 float vis = soft ? sdf_penumbra(res) : (hit ? 0.0 : 1.0);
                 if (vis > 0.0) acc += sc * vis;
@@ -357,12 +364,6 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
         }
     }
     return acc;
-}
-
-float sdf_to_srgb(float v) {
-    if (!(v > 0.0)) return 0.0;
-    if (v >= 1.0) return 1.0;
-    return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
 }
 
 // The picture at fragCoord (GL convention: origin at the bottom left) for a res-sized
@@ -375,18 +376,17 @@ vec4 sdf_render(vec2 frag_coord, vec2 res, float time, vec4 orbit, vec2 pan) {
     float x = floor(frag_coord.x), row = floor(res.y) - 1.0 - floor(frag_coord.y);
     if (SDF_2D) {
         // A 2D model: W x H samples over [-1, 1]^2 including both ends, white inside.
-        float sx = res.x > 1.0 ? 2.0 / (floor(res.x) - 1.0) : 0.0;
-        float sy = res.y > 1.0 ? 2.0 / (floor(res.y) - 1.0) : 0.0;
-        float v = map(vec3(-1.0 + sx * x, 1.0 - sy * row, 0.0)) < 0.0 ? 1.0 : 0.0;
+        float v = map(vec3(sdf_grid_x(int(x), int(res.x)), sdf_grid_y(int(row), int(res.y)), 0.0)) < 0.0 ? 1.0 : 0.0;
         return vec4(vec3(v), 1.0);
     }
     vec3 pos = sdf_cam_position, target = sdf_cam_target;
     if (orbit.w > 0.0) sdf_orbit(pos, target, sdf_cam_up, orbit, pan);
-    sdf_setup_camera(pos, target, sdf_cam_up, sdf_cam_fov, sdf_cam_ortho_height, floor(res));
+    sdf_cam = sdf_make_camera(pos, target, sdf_cam_up, sdf_cam_fov, SDF_ORTHO, sdf_cam_ortho_height, floor(res.x), floor(res.y));
+    if (SDF_PREMARCH) sdf_setup_premarch(x, row, floor(res));
     vec3 acc = vec3(0.0);
     for (int s = sdf_zero; s < SDF_SAMPLES; ++s) {
         vec3 o, d;
-        sdf_camera_ray(x + SDF_OFFSETS[s].x, row + SDF_OFFSETS[s].y, o, d);
+        sdf_camera_ray(sdf_cam, x + SDF_OFFSETS[s].x, row + SDF_OFFSETS[s].y, o, d);
         acc += sdf_trace(o, d, SDF_SAMPLE_WEIGHT);
     }
     acc = vec3(acc.x >= 0.0 ? min(acc.x, 1e30) : 0.0, acc.y >= 0.0 ? min(acc.y, 1e30) : 0.0, acc.z >= 0.0 ? min(acc.z, 1e30) : 0.0);

@@ -39,7 +39,7 @@ SDF_FN vec3 sdf_nonneg3(vec3 v) {
 // ---- tolerances along a ray ----
 // Hit threshold at path length `path` (relative beyond one unit), the radius of one pixel's
 // footprint (cone tracing, and "close enough" for rays out of steps), and the offset that
-// takes a secondary ray off its surface (4 thresholds plus what float precision at p needs).
+// takes a secondary ray off its surface (4 thresholds plus what floats at p resolve).
 SDF_FN float sdf_thr(float eps, float path) { return eps * max(path, 1.0f); }
 SDF_FN float sdf_footprint(float foot_base, float foot_slope, float path) { return foot_base + foot_slope * path; }
 SDF_FN float sdf_bias(float eps, vec3 p, float path) { return 4.0f * sdf_thr(eps, path) + 2e-5f * (1.0f + sdf_maxabs3(p)); }
@@ -172,7 +172,7 @@ SDF_FN float sdf_penumbra(float res) {
 
 // ---- surfaces ----
 // Tetrahedron technique: the gradient is sum_k tetra(k) * map(p + e * tetra(k)), with e
-// sdf_normal_eps (never under what float precision at p resolves).
+// sdf_normal_eps (never under what floats at p resolve).
 SDF_FN vec3 sdf_tetra(int k) {
     vec3 v = vec3(1.0f);
     if (k == 0) v = vec3(1.0f, -1.0f, -1.0f);
@@ -342,6 +342,36 @@ SDF_FN void sdf_camera_ray(SdfCamera c, float px, float py, SDF_OUT(vec3) o, SDF
         o = c.eye;
         d = normalize(c.fwd + u * c.right + v * c.up);
     }
+}
+
+// ---- tile pre-marching ----
+// Primary rays are traced in square tiles (holding about 256+ samples, so the CPU's lane
+// window stays full) whose rays all start where one cone march along the tile's central ray
+// ends: every ray of the tile (directions within the corners' cone, origins within the
+// corners') stays within r0 + r1 t of the axis point at the same t, so where the axis has
+// distance d at t, the ball of radius d around it holds every ray's points up to t + step
+// for step = d - (r0 + r1 t) - thr(t + d): no surface there, nor any point where plain
+// tracing could have stopped.
+SDF_FN int sdf_tile_size(int samples) { return samples <= 2 ? 16 : (samples <= 8 ? 8 : 4); }
+SDF_FN void sdf_tile_cone(SdfCamera c, float x0, float y0, float x1, float y1, SDF_OUT(vec3) o, SDF_OUT(vec3) d,
+                          SDF_OUT(vec2) r) {
+    sdf_camera_ray(c, 0.5f * (x0 + x1), 0.5f * (y0 + y1), o, d);
+    float r0 = 0.0f, r1 = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+        vec3 qo, qd;
+        sdf_camera_ray(c, (k & 1) != 0 ? x1 : x0, (k & 2) != 0 ? y1 : y0, qo, qd);
+        r0 = max(r0, length(qo - o));
+        r1 = max(r1, length(qd - d));
+    }
+    r = vec2(r0 * 1.01f + 1e-6f, r1 * 1.01f + 1e-6f);  // rounding margin
+}
+// One step of the pre-march at t with distance dist; false when it ends (at most 32 steps,
+// and never past max_dist).
+SDF_FN bool sdf_premarch_step(float dist, vec2 r, float eps, SDF_INOUT(float) t) {
+    float step = dist - (r.x + r.y * t) - sdf_thr(eps, t + dist);
+    bool more = step > 1e-3f * max(t, 1.0f);  // (NaN: no)
+    if (more) t += step;
+    return more;
 }
 
 // A 2D model's W x H samples over [-1, 1]^2, both ends included (column i of n, row j of n

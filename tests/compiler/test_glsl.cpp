@@ -343,7 +343,8 @@ TEST_CASE("glsl: every function the renderer's .glsl files call is defined", "[g
         std::string text;
         std::set<std::string> also;
     };
-    const Part parts[] = {{"renderer", std::string(glsl::kRendererHead) + std::string(glsl::kRendererBody), scene},
+    const std::string rules = glsl::shared_rules_glsl(glsl::kSharedRules);
+    const Part parts[] = {{"renderer", rules + std::string(glsl::kRendererHead) + std::string(glsl::kRendererBody), scene},
                           {"noise", std::string(om::kGlslNoise), {}}};
     for (const Part& p : parts) {
         const std::set<std::string> defs = defined(p.text);
