@@ -101,21 +101,6 @@ CompiledScene compile_scene(const Scene& scene) {
         r.radius = constant(g, l.radius, l.loc, "the light radius");
         cs.lights.push_back(r);
     }
-    if (cs.lights.empty()) {
-        // Default rig: a key light over the camera's shoulder and a dim fill from the other side.
-        ResolvedLight key;
-        key.directional = true;
-        glm::vec3 fwd = glm::normalize(cs.camera.target - cs.camera.position);
-        glm::vec3 right = glm::normalize(glm::cross(fwd, cs.camera.up));
-        key.direction = glm::normalize(fwd + 0.6f * right - 1.2f * glm::normalize(cs.camera.up));
-        key.color = glm::vec3(1.0f, 0.97f, 0.92f);
-        key.intensity = 1.0f;
-        ResolvedLight fill = key;
-        fill.direction = glm::normalize(fwd - 0.8f * right - 0.3f * glm::normalize(cs.camera.up));
-        fill.color = glm::vec3(0.55f, 0.6f, 0.7f);
-        fill.intensity = 0.35f;
-        cs.lights = {key, fill};
-    }
     cs.ambient = constant3(g, scene.ambient, c.loc, "the ambient color");
     cs.background = constant3(g, scene.background, c.loc, "the background color");
     cs.render = scene.render;

@@ -41,7 +41,7 @@ struct CompiledScene {
     Program distance;  // outputs: "d", a 1-Lipschitz bound of the distance
     Program shading;   // outputs: "d", then the kMatChannels material channels
     ResolvedCamera camera;
-    std::vector<ResolvedLight> lights;  // never empty: defaults when the script has none
+    std::vector<ResolvedLight> lights;  // the script's (none: the render plan's default rig)
     glm::vec3 ambient{0.05f}, background{0.0f};
     RenderSettings render;
     Bounds bounds;

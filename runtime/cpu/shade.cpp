@@ -209,7 +209,7 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
     }
 
     // Direct light, one batched shadow pass per light.
-    for (const ResolvedLight& light : f_.scene->lights) {
+    for (const ResolvedLight& light : f_.lights) {
         const glm::vec3 radiance = light.color * light.intensity;
         if (!(max3(radiance) > 0.0f) || !std::isfinite(max3(radiance))) continue;
         glm::vec3 ldir = -light.direction;
