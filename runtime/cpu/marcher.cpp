@@ -40,8 +40,6 @@
 
 namespace sdfc::cpu {
 namespace {
-constexpr float kRelaxNear = 8.0f;  // over-relaxed steps only where d >= this many hit thresholds
-constexpr float kSoftRelaxFar = 4.0f;  // soft shadows: over-relaxed only where d >= this x the cone width
 }  // namespace
 
 // Lanes [0, n) whose point left their cached leaf box find their leaf.
@@ -188,39 +186,22 @@ void Worker::march(const RaySet& rs) {
     run(
         rs, [](Lanes&, int) {},
         [&](Lanes& L, int m, const float* d) {
+            // Over-relaxed sphere tracing (rules.h sdf_relaxed_step); a holds the value the
+            // hit test reads.
             for (int i = 0; i < m; ++i) {
-                const float s = L.sign[i] * d[i], r = std::fabs(s);
-                // Over-relaxation: step omega * d while consecutive unbounding spheres
-                // overlap; when they do not, or the step went through the surface (s < 0),
-                // a surface may lie between: step back inside the previous sphere and
-                // continue with omega = 1. Near the surface (d within kRelaxNear hit
-                // thresholds) the steps are plain, so that grazing rays are sampled where
-                // plain sphere tracing samples them and hit or miss alike.
-                const float thr = eps * std::max(L.t0[i] + L.t[i], 1.0f);
-                const bool fail = (L.om[i] > 1.0f) & (L.sl[i] > L.pr[i]) & ((r + L.pr[i] < L.sl[i]) | (s < 0.0f));
-                // (A relaxed step past tmax is not taken: only a plain step may end the ray.)
-                const float om = (s > kRelaxNear * thr) & (L.t[i] + L.om[i] * s <= L.tmax[i]) ? L.om[i] : 1.0f;
-                const float step = fail ? L.pr[i] - L.sl[i] : om * s;
-                L.om[i] = fail ? 1.0f : L.om[i];
-                L.sl[i] = step;
-                L.pr[i] = r;
                 const int st = ++L.steps[i];
-                const bool stop = ((s < thr) & !fail) | (st >= max_steps);  // hit, or out of steps (decided in finish)
-                const float tn = L.t[i] + step;
-                const bool out = !(tn <= L.tmax[i]);  // also NaN
-                L.a[i] = fail ? INFINITY : s;
-                L.t[i] = stop ? L.t[i] : tn;
-                L.done[i] = stop | out;
+                float last;
+                L.done[i] = rules::sdf_relaxed_step(L.sign[i] * d[i], L.t0[i], L.tmax[i], false, st, max_steps, eps, L.t[i], L.om[i],
+                                                    L.pr[i], L.sl[i], last);
+                L.a[i] = last;
             }
         },
         [&](Lanes& L, int i) {
             const uint32_t r = L.ray[i];
             const float s = L.a[i], path = L.t0[i] + L.t[i];
             steps_[r] = L.steps[i];
-            hit_[r] = s < f_.thr(path) || (L.steps[i] >= max_steps && s < f_.footprint(path));
-            // A hit moves on by its last distance: still outside (1-Lipschitz), and much
-            // closer to the surface, wherever the last step began (same with --baseline).
-            t_[r] = hit_[r] && s > 0.0f ? L.t[i] + s : L.t[i];
+            hit_[r] = rules::sdf_relaxed_hit(s, path, L.steps[i], max_steps, eps, f_.camera.footprint_base(), f_.camera.footprint_slope());
+            t_[r] = rules::sdf_hit_t(L.t[i], s, hit_[r]);
         },
         [&](uint32_t r) { t_[r] = rs.tmax[r]; },
         [&](Lanes& L, int i, float slo, float te) { return skip_sphere(L, i, slo, te); },
@@ -244,46 +225,19 @@ void Worker::march_raw(const RaySet& rs, bool shadow) {
         steps_.assign(n, 0);
     }
     const int max_steps = f_.max_steps;
-    constexpr int kBisect = 12;
     const float inv_l = 1.0f / f_.raw_lipschitz;
+    const float foot_base = f_.camera.footprint_base(), foot_slope = f_.camera.footprint_slope();
     run(
         rs, [](Lanes& L, int i) { L.a[i] = -1.0f, L.sl[i] = 0.0f, L.om[i] = 0.0f; },
         [&](Lanes& L, int m, const float* dist) {
+            // Sign-change marching with bisection (rules.h sdf_raw_step): a = previous t,
+            // b / w = bracket, sl = halvings, om = 1 when the ray ended as a hit.
             for (int i = 0; i < m; ++i) {
-                const float s = L.sign[i] * dist[i], t = L.t[i], path = L.t0[i] + t;
                 const int st = ++L.steps[i];
-                bool done = false, hit = false;
-                if (L.sl[i] > 0.0f) {
-                    // Bisection: keep the outside end in b, the inside end in w.
-                    if (s < 0.0f) L.w[i] = t;
-                    else L.b[i] = t;
-                    L.sl[i] += 1.0f;
-                    if (L.sl[i] > kBisect || L.w[i] - L.b[i] < f_.thr(path)) {
-                        L.t[i] = L.b[i];
-                        done = hit = true;
-                    } else {
-                        L.t[i] = 0.5f * (L.b[i] + L.w[i]);
-                    }
-                } else if (s <= 0.0f) {  // a sign change (values are not distances: "close" means nothing)
-                    if (s == 0.0f || L.a[i] < 0.0f || shadow) {
-                        done = hit = true;
-                    } else {
-                        L.b[i] = L.a[i], L.w[i] = t, L.sl[i] = 1.0f;
-                        L.t[i] = 0.5f * (L.b[i] + L.w[i]);
-                    }
-                } else {
-                    const float step = s == s ? std::clamp(s * inv_l, f_.footprint(path), f_.raw_max_step) : f_.footprint(path);
-                    L.a[i] = t;
-                    L.t[i] = t + step;
-                    done = !(L.t[i] <= L.tmax[i]);
-                }
-                if (!done && st >= max_steps) {
-                    done = true;
-                    hit = L.sl[i] > 0.0f;  // inside a bracket: take its outside end
-                    if (hit) L.t[i] = L.b[i];
-                }
+                bool hit;
+                L.done[i] = rules::sdf_raw_step(L.sign[i] * dist[i], L.t0[i], L.tmax[i], shadow, st, max_steps, f_.eps, foot_base,
+                                                foot_slope, inv_l, f_.raw_max_step, L.t[i], L.a[i], L.b[i], L.w[i], L.sl[i], hit);
                 L.om[i] = hit ? 1.0f : 0.0f;
-                L.done[i] = done;
             }
         },
         [&](Lanes& L, int i) {
@@ -399,29 +353,20 @@ void Worker::shadow_hard(const RaySet& rs) {
     run(
         rs, [](Lanes&, int) {},
         [&](Lanes& L, int m, const float* d) {
+            // Over-relaxed like march() (plain near surfaces); a blocker only counts at a
+            // safe point (a point inside an occluder is one: it blocks).
             for (int i = 0; i < m; ++i) {
-                // Over-relaxed like march() (plain near surfaces); a blocker only counts at a
-                // safe point (a point inside an occluder is one: it blocks).
-                const float r = std::fabs(d[i]);
-                const float thr = eps * std::max(L.t0[i] + L.t[i], 1.0f);
-                const bool fail = (L.om[i] > 1.0f) & (L.sl[i] > L.pr[i]) & (r + L.pr[i] < L.sl[i]);
-                const float om = (d[i] > kRelaxNear * thr) & (L.t[i] + L.om[i] * d[i] < L.tmax[i]) ? L.om[i] : 1.0f;
-                const float step = fail ? L.pr[i] - L.sl[i] : om * d[i];
-                L.om[i] = fail ? 1.0f : L.om[i];
-                L.sl[i] = step;
-                L.pr[i] = r;
                 const int st = ++L.steps[i];
-                const bool stop = ((d[i] < thr) & !fail) | (st >= max_steps);
-                const float tn = L.t[i] + step;
-                const bool out = !(tn < L.tmax[i]);  // also NaN: no occluder found
-                L.a[i] = fail ? INFINITY : d[i];
-                L.t[i] = stop ? L.t[i] : tn;
-                L.done[i] = stop | out;
+                float last;
+                L.done[i] = rules::sdf_relaxed_step(d[i], L.t0[i], L.tmax[i], true, st, max_steps, eps, L.t[i], L.om[i], L.pr[i],
+                                                    L.sl[i], last);
+                L.a[i] = last;
             }
         },
         [&](Lanes& L, int i) {
             const float d = L.a[i], path = L.t0[i] + L.t[i];
-            const bool blocked = d < f_.thr(path) || (L.steps[i] >= max_steps && d < f_.footprint(path));
+            const bool blocked =
+                rules::sdf_relaxed_hit(d, path, L.steps[i], max_steps, eps, f_.camera.footprint_base(), f_.camera.footprint_slope());
             vis_[L.ray[i]] = blocked ? 0.0f : 1.0f;
         },
         [](uint32_t) {}, [&](Lanes& L, int i, float slo, float te) { return skip_sphere(L, i, slo, te); },
@@ -444,41 +389,16 @@ void Worker::shadow_soft(const RaySet& rs) {
             L.b[i] = 1e20f;
         },
         [&](Lanes& L, int m, const float* dist) {
+            // Quilez's penumbra with the closest-approach refinement, over-relaxed far from
+            // any penumbra (rules.h sdf_soft_step): a = res, b = the previous positive distance.
             for (int i = 0; i < m; ++i) {
-                const float h = dist[i], t = L.t[i], w = L.w[i], r = std::fabs(h);
-                const float thr = eps * std::max(L.t0[i] + t, 1.0f);
-                const bool pos = h > 0.0f;
-                // The last over-relaxed step left the previous sphere (or entered a solid):
-                // back to that sphere's boundary, plain steps from there; no sample taken.
-                const bool fail = (L.om[i] > 1.0f) & (L.sl[i] > L.pr[i]) & ((r + L.pr[i] < L.sl[i]) | !pos);
-                // Closest approach between this sample and the previous one (Quilez 2018;
-                // for a step s longer than the previous distance b, the point both spheres
-                // touch: y = (s^2 + h^2 - b^2) / 2s, which is h^2 / 2b when s = b);
-                // inside an occluder, the (negative) depth relative to the cone.
-                const float pb = L.b[i], ps = L.sl[i];
-                const float y0 = ps > pb && pb < 1e19f ? (ps * ps + h * h - pb * pb) / (2.0f * ps) : h * h / (2.0f * pb);
-                const float y = std::min(std::max(y0, 0.0f), 0.999f * h);
-                const float dd = std::sqrt(std::max(h * h - y * y, 0.0f));
-                const float est = pos ? dd / (w * std::max(t - y, 1e-20f)) : h / (w * std::max(t, 1e-20f));
-                const float res = (est < L.a[i]) & !fail ? est : L.a[i];  // NaN keeps res
-                L.a[i] = res;
-                L.b[i] = fail ? L.b[i] : (pos ? h : 1e20f);
-                // Sphere tracing outside; through an occluder in steps of a quarter cone width.
-                const bool far = pos & (h > kSoftRelaxFar * w * t) & (h > kRelaxNear * thr) & (t + L.om[i] * h < L.tmax[i]);
-                const float om = far ? L.om[i] : 1.0f;
-                const float step = fail ? L.pr[i] - L.sl[i] : pos ? std::max(om * h, thr) : std::max(0.25f * w * t, thr);
-                L.om[i] = fail ? 1.0f : L.om[i];
-                L.sl[i] = step;
-                L.pr[i] = r;
-                const float tn = t + step;
-                L.t[i] = tn;
                 const int st = ++L.steps[i];
-                L.done[i] = (h != h) | (res <= -1.0f) | (st >= max_steps) | !(tn < L.tmax[i]);
+                L.done[i] = rules::sdf_soft_step(dist[i], L.t0[i], L.tmax[i], L.w[i], st, max_steps, eps, L.t[i], L.a[i], L.b[i],
+                                                 L.om[i], L.pr[i], L.sl[i]);
             }
         },
         [&](Lanes& L, int i) {
-            const float res = std::clamp(L.a[i], -1.0f, 1.0f);
-            vis_[L.ray[i]] = 0.25f * (1.0f + res) * (1.0f + res) * (2.0f - res);
+            vis_[L.ray[i]] = rules::sdf_penumbra(L.a[i]);
         },
         [](uint32_t) {},
         [&](Lanes& L, int i, float slo, float te) {
