@@ -32,30 +32,32 @@
 namespace sdfc::cpu {
 namespace {
 
-constexpr int kAoTaps = 5;
-constexpr float kMinWeight = 1e-3f;
+using namespace rules;
 
-float schlick(float cos_theta, float ior) {
-    float r0 = (ior - 1.0f) / (ior + 1.0f);
-    r0 *= r0;
-    float m = 1.0f - clamp01(cos_theta);
-    float m2 = m * m;
-    return r0 + (1.0f - r0) * m2 * m2 * m;
+constexpr int kAoTaps = 5;
+
+// A material channel made safe to shade with, by its clamp rule (compiler/scene/materials.def).
+float safe_channel(float v, MatClamp c) {
+    switch (c) {
+        case MatClamp::NonNeg: return sdf_nonneg(v);
+        case MatClamp::Unit: return sdf_clamp01(v);
+        case MatClamp::Shininess: return sdf_safe_shininess(v);
+        case MatClamp::Ior: return sdf_safe_ior(v);
+    }
+    return v;
 }
 
 }  // namespace
 
 void Worker::compute_normals(const RaySet& h) {
-    static constexpr float kx[4] = {1, -1, -1, 1}, ky[4] = {-1, -1, 1, 1}, kz[4] = {-1, 1, -1, 1};
     const size_t n = h.size();
     px_.resize(n * 4), py_.resize(n * 4), pz_.resize(n * 4), pd_.resize(n * 4);
     for (size_t i = 0; i < n; ++i) {
         const glm::vec3 p = h.o(i);
-        const float e = std::max(f_.thr(h.t0[i]), 2e-5f * (1.0f + maxabs3(p)));
+        const float e = sdf_normal_eps(f_.eps, p, h.t0[i]);
         for (int k = 0; k < 4; ++k) {
-            px_[i * 4 + k] = p.x + e * kx[k];
-            py_[i * 4 + k] = p.y + e * ky[k];
-            pz_[i * 4 + k] = p.z + e * kz[k];
+            const glm::vec3 q = p + e * sdf_tetra(k);
+            px_[i * 4 + k] = q.x, py_[i * 4 + k] = q.y, pz_[i * 4 + k] = q.z;
         }
     }
     kind_ = RenderStats::kNormals;
@@ -63,14 +65,10 @@ void Worker::compute_normals(const RaySet& h) {
     kind_ = RenderStats::kRays;
     nx_.resize(n), ny_.resize(n), nz_.resize(n);
     for (size_t i = 0; i < n; ++i) {
-        const float* d = &pd_[i * 4];
-        glm::vec3 g(d[0] * kx[0] + d[1] * kx[1] + d[2] * kx[2] + d[3] * kx[3],
-                    d[0] * ky[0] + d[1] * ky[1] + d[2] * ky[2] + d[3] * ky[3],
-                    d[0] * kz[0] + d[1] * kz[1] + d[2] * kz[2] + d[3] * kz[3]);
-        const float len2 = glm::dot(g, g);
-        if (len2 > 1e-30f && std::isfinite(len2)) g *= 1.0f / std::sqrt(len2);
-        else g = -h.d(i);  // flat or broken field: face the viewer
-        nx_[i] = g.x, ny_[i] = g.y, nz_[i] = g.z;
+        glm::vec3 g(0.0f);
+        for (int k = 0; k < 4; ++k) g += sdf_tetra(k) * pd_[i * 4 + k];
+        const glm::vec3 nrm = sdf_normal(g, h.d(i));
+        nx_[i] = nrm.x, ny_[i] = nrm.y, nz_[i] = nrm.z;
     }
 }
 
@@ -90,21 +88,13 @@ void Worker::compute_materials(const RaySet& h) {
                 for (int i = 0; i < m; ++i) mat_[(i0 + i) * kMatOut + c] = o[i];
             }
         } else {
-            for (int i = 0; i < m; ++i) {
-                float* q = &mat_[(i0 + i) * kMatOut];
-                std::fill_n(q, kMatOut, 0.0f);
-                q[kMatR] = q[kMatG] = q[kMatB] = 0.8f;
-                q[kMatSpecular] = 0.5f, q[kMatShininess] = 32.0f, q[kMatIor] = 1.5f;
-            }
+            for (int i = 0; i < m; ++i)
+                for (int c = 0; c < kMatOut; ++c) mat_[(i0 + i) * kMatOut + c] = kMatChannelInfo[c].def;
         }
     }
     for (size_t i = 0; i < n; ++i) {
         float* q = &mat_[i * kMatOut];
-        for (int c : {kMatR, kMatG, kMatB, kMatSpecular, kMatEmitR, kMatEmitG, kMatEmitB}) q[c] = nonneg(q[c]);
-        q[kMatShininess] = std::isfinite(q[kMatShininess]) ? std::clamp(q[kMatShininess], 0.0f, 1e4f) : 32.0f;
-        q[kMatReflect] = clamp01(q[kMatReflect]);
-        q[kMatTransparency] = clamp01(q[kMatTransparency]);
-        q[kMatIor] = (std::isfinite(q[kMatIor]) && q[kMatIor] > 1e-3f) ? q[kMatIor] : 1.5f;
+        for (int c = 0; c < kMatOut; ++c) q[c] = safe_channel(q[c], kMatChannelInfo[c].clamp);
     }
 }
 
@@ -126,7 +116,7 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
     compute_materials(h);
 
     const bool can_spawn = gen < f_.max_bounces;
-    const float min_w = kMinWeight / static_cast<float>(f_.samples);
+    const float min_w = f_.min_weight;
     local_.clear(), lw_.clear(), lnx_.clear(), lny_.clear(), lnz_.clear();
     for (size_t i = 0; i < n; ++i) {
         const glm::vec3 P = h.o(i), D = h.d(i), W = h.w(i);
@@ -140,7 +130,7 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
             if (!can_spawn) continue;
             const glm::vec3 T = glm::refract(D, Nf, ior);
             float F = 1.0f;
-            if (glm::dot(T, T) > 0.0f) F = schlick(-glm::dot(T, Nf), ior);
+            if (glm::dot(T, T) > 0.0f) F = sdf_schlick(-glm::dot(T, Nf), ior);
             const glm::vec3 wr = W * F, wt = W * (1.0f - F);
             if (max3(wr) >= min_w) push_secondary(next, P + Nf * bias, glm::reflect(D, Nf), h.t0[i], wr, h.prim[i], true);
             if (max3(wt) >= min_w) push_secondary(next, P - Nf * bias, glm::normalize(T), h.t0[i], wt, h.prim[i], false);
@@ -161,7 +151,7 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
             const glm::vec3 base = W * ((1.0f - refl) * tr);
             const glm::vec3 T = glm::refract(D, Nf, 1.0f / ior);
             float F = 1.0f;
-            if (glm::dot(T, T) > 0.0f) F = schlick(-glm::dot(D, Nf), ior);
+            if (glm::dot(T, T) > 0.0f) F = sdf_schlick(-glm::dot(D, Nf), ior);
             w_refl += base * F;
             const glm::vec3 wt = base * (1.0f - F) * glm::vec3(m[kMatR], m[kMatG], m[kMatB]);
             if (max3(wt) >= min_w) push_secondary(next, P - Nf * bias, glm::normalize(T), h.t0[i], wt, h.prim[i], true);
@@ -181,7 +171,7 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
             for (size_t k = 0; k < nl; ++k) {
                 const glm::vec3 P = h.o(local_[k]);
                 for (int j = 0; j < kAoTaps; ++j) {
-                    const float s = 0.01f + 0.12f * static_cast<float>(j) / (kAoTaps - 1);
+                    const float s = sdf_ao_offset(j);
                     px_[k * kAoTaps + j] = P.x + lnx_[k] * s;
                     py_[k * kAoTaps + j] = P.y + lny_[k] * s;
                     pz_[k * kAoTaps + j] = P.z + lnz_[k] * s;
@@ -192,13 +182,8 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
             kind_ = RenderStats::kRays;
             for (size_t k = 0; k < nl; ++k) {
                 float occ = 0.0f, sca = 1.0f;
-                for (int j = 0; j < kAoTaps; ++j) {
-                    const float s = 0.01f + 0.12f * static_cast<float>(j) / (kAoTaps - 1);
-                    const float d = pd_[k * kAoTaps + j];
-                    if (d < s) occ += (s - d) * sca;  // (NaN adds nothing)
-                    sca *= 0.95f;
-                }
-                ao_[k] = clamp01(1.0f - 3.0f * occ);
+                for (int j = 0; j < kAoTaps; ++j) sdf_ao_tap(pd_[k * kAoTaps + j], j, occ, sca);
+                ao_[k] = sdf_ao_visibility(occ);
             }
         }
         for (size_t k = 0; k < nl; ++k) {
@@ -228,17 +213,14 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
                 dist = glm::length(L);
                 if (!(dist > 1e-6f)) continue;
                 L /= dist;
-                falloff = 1.0f / (dist * dist);
+                falloff = sdf_falloff(dist);
             }
             const float ndl = glm::dot(N, L);
             if (!(ndl > 0.0f)) continue;
-            const glm::vec3 V = -h.d(i);
-            const glm::vec3 Hv = glm::normalize(L + V);
             const float* m = &mat_[i * kMatOut];
-            const float ndh = std::max(glm::dot(N, Hv), 0.0f);
-            const float spec = m[kMatSpecular] > 0.0f ? m[kMatSpecular] * std::pow(ndh, m[kMatShininess]) : 0.0f;
             const glm::vec3 lw(lw_[k * 3], lw_[k * 3 + 1], lw_[k * 3 + 2]);
-            const glm::vec3 c = lw * radiance * falloff * (glm::vec3(m[kMatR], m[kMatG], m[kMatB]) * ndl + spec);
+            const glm::vec3 c = lw * radiance * falloff *
+                                sdf_blinn_phong(N, L, -h.d(i), glm::vec3(m[kMatR], m[kMatG], m[kMatB]), m[kMatSpecular], m[kMatShininess]);
             if (!f_.shadows) {
                 add_shaded(h.prim[i], c);
                 continue;
