@@ -1,10 +1,12 @@
-// Camera: maps a continuous image position (in pixels) to a world-space ray.
+// Camera: maps a continuous image position (in pixels) to a world-space ray (the rules of
+// compiler/render/rules.h, sdf_make_camera and sdf_camera_ray, which the shader runs too).
 // Pinhole (vertical field of view) or orthographic (ortho_height world units tall).
 // Pixel (x, y) covers [x, x+1) x [y, y+1); its centre is (x + 0.5, y + 0.5); row 0 is the top.
 #pragma once
 #include <glm/glm.hpp>
 
 #include "compiler/bytecode/compile.hpp"
+#include "compiler/render/rules.h"
 
 namespace sdfc {
 
@@ -26,21 +28,18 @@ public:
 
     // Radius of one pixel's footprint at distance t along a ray: base + slope * t.
     // Used by cone tracing and as the "close enough" tolerance of rays that run out of steps.
-    float footprint_base() const { return foot_base_; }
-    float footprint_slope() const { return foot_slope_; }
+    float footprint_base() const { return c_.foot_base; }
+    float footprint_slope() const { return c_.foot_slope; }
 
-    bool orthographic() const { return ortho_; }
-    const glm::vec3& position() const { return pos_; }
-    const glm::vec3& forward() const { return fwd_; }
-    const glm::vec3& right() const { return right_; }
-    const glm::vec3& up() const { return up_; }
+    bool orthographic() const { return c_.ortho; }
+    const glm::vec3& position() const { return c_.eye; }
+    const glm::vec3& forward() const { return c_.fwd; }
+    const glm::vec3& right() const { return c_.right; }
+    const glm::vec3& up() const { return c_.up; }
+    const rules::SdfCamera& rule_camera() const { return c_; }
 
 private:
-    glm::vec3 pos_, fwd_, right_, up_;
-    float half_w_ = 1, half_h_ = 1;  // perspective: tan-space half extents; ortho: world half extents
-    float inv_w_ = 1, inv_h_ = 1;
-    float foot_base_ = 0, foot_slope_ = 0;
-    bool ortho_ = false;
+    rules::SdfCamera c_;  // the camera of both renderers (rules.h)
 };
 
 }  // namespace sdfc

@@ -419,32 +419,19 @@ void Worker::shadow_soft(const RaySet& rs) {
         [](Lanes& L, int i) { L.t[i] = L.tmax[i]; });
 }
 
-// Tile cone pre-marching: one march along the tile's central ray for all its primary rays.
-// Every ray of the tile (directions within the corners' cone, origins within the corners')
-// stays within R(t) = r0 + t * r1 of the axis point at the same t, so when the axis has
-// distance d at t, the ball of radius d around it holds every ray's points up to t + step
-// for step = d - R(t) - thr(t + d): no surface there, nor any point where plain tracing
-// would stop (d >= its hit threshold). The rays then start at the final t.
+// Tile cone pre-marching: one march along the tile's central ray for all its primary rays
+// (rules.h sdf_tile_cone, sdf_premarch_step: why it is safe); they start at the final t.
 float Worker::tile_start(int x0, int y0, int x1, int y1) {
-    const Ray c = f_.camera.ray(0.5f * static_cast<float>(x0 + x1), 0.5f * static_cast<float>(y0 + y1));
-    float r0 = 0.0f, r1 = 0.0f;
-    for (int k = 0; k < 4; ++k) {
-        const Ray q = f_.camera.ray(static_cast<float>(k & 1 ? x1 : x0), static_cast<float>(k & 2 ? y1 : y0));
-        r0 = std::max(r0, glm::length(q.origin - c.origin));
-        r1 = std::max(r1, glm::length(q.dir - c.dir));
-    }
-    r0 = r0 * 1.01f + 1e-6f, r1 = r1 * 1.01f + 1e-6f;  // rounding margin
-    float t = 0.0f, tmax = f_.max_dist;
-    f_.clip_ray(c.origin, c.dir, t, tmax);  // (not the start: other rays may enter the box sooner)
-    t = 0.0f;
-    constexpr int kMaxConeSteps = 32;
-    for (int i = 0; i < kMaxConeSteps && t < f_.max_dist; ++i) {
-        const glm::vec3 p = c.origin + c.dir * t;
-        float d;
-        eval_points(&p.x, &p.y, &p.z, 1, &d);
-        const float step = d - (r0 + r1 * t) - f_.thr(t + d);
-        if (!(step > 1e-3f * std::max(t, 1.0f))) break;  // also NaN
-        t += step;
+    glm::vec3 o, d;
+    glm::vec2 r;
+    rules::sdf_tile_cone(f_.camera.rule_camera(), static_cast<float>(x0), static_cast<float>(y0), static_cast<float>(x1),
+                         static_cast<float>(y1), o, d, r);
+    float t = 0.0f;
+    for (int i = 0; i < 32 && t < f_.max_dist; ++i) {
+        const glm::vec3 p = o + d * t;
+        float dist;
+        eval_points(&p.x, &p.y, &p.z, 1, &dist);
+        if (!rules::sdf_premarch_step(dist, r, f_.eps, t)) break;
     }
     return t;
 }

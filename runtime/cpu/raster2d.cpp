@@ -24,6 +24,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
+#include "compiler/render/rules.h"
 #include "runtime/eval/interval.hpp"
 #include "runtime/cpu/slice.hpp"
 #include "runtime/eval/vm.hpp"
@@ -36,8 +37,8 @@ namespace {
 
 // Pixel coordinates, shared by every path so they produce the same floats. Both are
 // monotonic in the pixel index, so a tile's coordinate interval is its corner pixels'.
-inline float coord_x(int i, int w) { return w > 1 ? -1.0f + 2.0f * float(i) / float(w - 1) : 0.0f; }
-inline float coord_y(int j, int h) { return h > 1 ? 1.0f - 2.0f * float(j) / float(h - 1) : 0.0f; }
+inline float coord_x(int i, int w) { return rules::sdf_grid_x(i, w); }  // (compiler/render/rules.h: the
+inline float coord_y(int j, int h) { return rules::sdf_grid_y(j, h); }  // shader samples the same grid)
 
 constexpr int kLeaf = 8;       // leaf tiles: 8 x 8 pixels = one VM batch
 constexpr int kMaxDepth = 12;  // 2^12 * 8 pixels: far beyond any image size we accept

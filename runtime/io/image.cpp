@@ -9,17 +9,14 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "compiler/render/rules.h"
 #include "runtime/io/atomic_file.hpp"
 
 namespace sdfc {
 
 namespace fs = std::filesystem;
 
-float linear_to_srgb(float v) {
-    if (!(v > 0.0f)) return 0.0f;  // also NaN
-    if (v >= 1.0f) return 1.0f;
-    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
+float linear_to_srgb(float v) { return rules::sdf_to_srgb(v); }  // the shader's encoding too
 
 float srgb_to_linear(float v) {
     if (!(v > 0.0f)) return 0.0f;

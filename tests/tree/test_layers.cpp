@@ -33,7 +33,7 @@ const std::vector<Layer>& layers() {
         {"compiler/render", {"compiler/bytecode", "compiler/scene", "compiler/ir", "compiler/base"}},
         {"compiler/glsl", {"compiler/render", "compiler/bytecode", "compiler/scene", "compiler/ir", "compiler/base"}},
         {"runtime/eval", {"compiler/bytecode", "compiler/scene", "compiler/ir", "compiler/base"}},
-        {"runtime/io", {"compiler/base"}},
+        {"runtime/io", {"compiler/render", "compiler/base"}},  // (rules.h's sRGB encoding only)
         {"runtime/cpu",
          {"runtime/eval", "runtime/io", "compiler/render", "compiler/bytecode", "compiler/scene", "compiler/ir",
           "compiler/base"}},
