@@ -219,34 +219,13 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
             // Cone tracing (primary rays only): where the ray passes an edge (d < the pixel
             // footprint without hitting) the closest approach is a partial hit of coverage
             // 1 - d/r; up to 4 are composited front to back, the final hit takes the rest.
-            float radius = max(sdf_footprint(sdf_cam.foot_base, sdf_cam.foot_slope, t), 1e-30);
-            bool done = false, hit = false;
-            if (dist < sdf_thr(SDF_EPSILON, t)) {
-                done = hit = true;
-            } else if (isnan(dist)) {
-                done = true;
-            } else {
-                float rho = dist / radius;
-                if (rho < 1.0) {
-                    if (rho < ca) { ca = rho; cb = t; }
-                } else if (ca < 1.0) {
-                    float cov = 1.0 - ca;
-                    if (ev_n < 4 && cov > 0.0) { ev_t[ev_n] = cb; ev_w[ev_n] = trans * cov; trans *= 1.0 - cov; ++ev_n; }
-                    ca = 2.0;
-                }
-                if (trans < 1e-3) {
-                    done = true;
-                } else if (steps >= SDF_MAX_STEPS) {
-                    done = true;
-                    hit = dist < radius;
-                } else {
-                    t += dist;
-                    done = !(t <= tmax);
-                }
-                if (done && !hit && ca < 1.0) {
-                    float cov = 1.0 - ca;
-                    if (ev_n < 4 && cov > 0.0) { ev_t[ev_n] = cb; ev_w[ev_n] = trans * cov; trans *= 1.0 - cov; ++ev_n; }
-                }
+            bool emitted, hit;
+            float et, ew;
+            bool done = sdf_cone_step(dist, 0.0, tmax, steps, SDF_MAX_STEPS, SDF_EPSILON, sdf_cam.foot_base, sdf_cam.foot_slope, t, ca,
+                                      cb, trans, ev_n, emitted, et, ew, hit);
+            if (emitted) {
+                ev_t[ev_n - 1] = et;
+                ev_w[ev_n - 1] = ew;
             }
             if (done) {
                 for (int q = 0; q < 4; ++q)

@@ -73,6 +73,61 @@ SDF_FN bool sdf_relaxed_step(float s, float t0, float tmax, bool strict, int ste
     return stop || past;
 }
 
+// Cone tracing of a primary ray (aa = "cone"): the cone's radius is the pixel footprint.
+// Where the ray passes an edge (d under the radius without hitting), the closest approach
+// (smallest d / radius = ca, at t = cb; 2: none) is a partial hit of coverage 1 - ca,
+// composited front to back (at most 4 events); the final hit, or the background, takes the
+// weight left (trans). A step records at most one event: `emitted`, at t = et with weight ew.
+SDF_FN void sdf_cone_emit(float coverage, float at, SDF_INOUT(float) trans, SDF_INOUT(int) events, SDF_OUT(bool) emitted,
+                          SDF_OUT(float) et, SDF_OUT(float) ew) {
+    emitted = events < 4 && coverage > 0.0f;
+    if (emitted) {
+        et = at;
+        ew = trans * coverage;
+        trans *= 1.0f - coverage;
+        events += 1;
+    }
+}
+SDF_FN bool sdf_cone_step(float d, float t0, float tmax, int steps, int max_steps, float eps, float foot_base, float foot_slope,
+                          SDF_INOUT(float) t, SDF_INOUT(float) ca, SDF_INOUT(float) cb, SDF_INOUT(float) trans,
+                          SDF_INOUT(int) events, SDF_OUT(bool) emitted, SDF_OUT(float) et, SDF_OUT(float) ew, SDF_OUT(bool) hit) {
+    float path = t0 + t;
+    float radius = max(sdf_footprint(foot_base, foot_slope, path), 1e-30f);
+    bool done = false;
+    hit = false;
+    emitted = false;
+    et = 0.0f;
+    ew = 0.0f;
+    if (d < sdf_thr(eps, path)) {
+        done = true;  // the axis hits: this surface takes the remaining weight
+        hit = true;
+    } else if (isnan(d)) {
+        done = true;
+    } else {
+        float rho = d / radius;
+        if (rho < 1.0f) {
+            if (rho < ca) {
+                ca = rho;
+                cb = t;
+            }
+        } else if (ca < 1.0f) {
+            sdf_cone_emit(1.0f - ca, cb, trans, events, emitted, et, ew);  // left an edge zone
+            ca = 2.0f;
+        }
+        if (trans < 1e-3f) {
+            done = true;  // fully covered by edges
+        } else if (steps >= max_steps) {
+            done = true;
+            hit = d < radius;
+        } else {
+            t = t + d;
+            done = !(t <= tmax);
+        }
+        if (done && !hit && ca < 1.0f) sdf_cone_emit(1.0f - ca, cb, trans, events, emitted, et, ew);
+    }
+    return done;
+}
+
 // A finished relaxed march hit when its last value is under the threshold, or, out of
 // steps, within one pixel footprint.
 SDF_FN bool sdf_relaxed_hit(float last, float path, int steps, int max_steps, float eps, float foot_base, float foot_slope) {

@@ -277,50 +277,27 @@ void Worker::cone_march(const RaySet& rs) {
     ev_w_.resize(n * kConeEvents);
     trans_.assign(n, 1.0f);
     const int max_steps = f_.max_steps;
+    const float foot_base = f_.camera.footprint_base(), foot_slope = f_.camera.footprint_slope();
     auto emit = [&](uint32_t r, float t, float coverage) {
-        int& k = ev_n_[r];
-        if (k >= kConeEvents || !(coverage > 0.0f)) return;
-        ev_t_[r * kConeEvents + k] = t;
-        ev_w_[r * kConeEvents + k] = trans_[r] * coverage;
-        trans_[r] *= 1.0f - coverage;
-        ++k;
+        bool emitted;
+        float et, ew;
+        rules::sdf_cone_emit(coverage, t, trans_[r], ev_n_[r], emitted, et, ew);
+        if (emitted) ev_t_[r * kConeEvents + ev_n_[r] - 1] = et, ev_w_[r * kConeEvents + ev_n_[r] - 1] = ew;
     };
     // Lane state: a = smallest d / r in the current edge zone (>= 1: none), b = its t,
-    // w = 1 when the final state is a hit.
+    // w = 1 when the final state is a hit (rules.h sdf_cone_step).
     run(
         rs, [](Lanes& L, int i) { L.a[i] = 2.0f; },
         [&](Lanes& L, int m, const float* dist) {
             for (int i = 0; i < m; ++i) {
                 const uint32_t r = L.ray[i];
-                const float d = dist[i], t = L.t[i], path = L.t0[i] + t;
-                const float radius = std::max(f_.footprint(path), 1e-30f);
                 const int st = ++L.steps[i];
-                bool done = false, hit = false;
-                if (d < f_.thr(path)) {
-                    done = hit = true;  // the axis hits: this surface takes the remaining weight
-                } else if (!(d == d)) {
-                    done = true;
-                } else {
-                    const float rho = d / radius;
-                    if (rho < 1.0f) {
-                        if (rho < L.a[i]) L.a[i] = rho, L.b[i] = t;
-                    } else if (L.a[i] < 1.0f) {
-                        emit(r, L.b[i], 1.0f - L.a[i]);  // left an edge zone: composite its closest approach
-                        L.a[i] = 2.0f;
-                    }
-                    if (trans_[r] < 1e-3f) {
-                        done = true;  // fully covered by edges
-                    } else if (st >= max_steps) {
-                        done = true;
-                        hit = d < radius;
-                    } else {
-                        L.t[i] = t + d;
-                        done = !(L.t[i] <= L.tmax[i]);
-                    }
-                    if (done && !hit && L.a[i] < 1.0f) emit(r, L.b[i], 1.0f - L.a[i]);
-                }
+                bool emitted, hit;
+                float et, ew;
+                L.done[i] = rules::sdf_cone_step(dist[i], L.t0[i], L.tmax[i], st, max_steps, f_.eps, foot_base, foot_slope, L.t[i],
+                                                 L.a[i], L.b[i], trans_[r], ev_n_[r], emitted, et, ew, hit);
+                if (emitted) ev_t_[r * kConeEvents + ev_n_[r] - 1] = et, ev_w_[r * kConeEvents + ev_n_[r] - 1] = ew;
                 L.w[i] = hit ? 1.0f : 0.0f;
-                L.done[i] = done;
             }
         },
         [&](Lanes& L, int i) {
