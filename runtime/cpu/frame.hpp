@@ -31,8 +31,15 @@ struct Frame : RenderPlan {
     bool want_depth = false, want_normal = false, want_steps = false;
     RenderView view = RenderView::Shaded;
     TapeTree tree;                  // leaf 0 (the full distance program) at least
-    Program regs;                   // no code: sizes the workers' distance register files
+    uint32_t max_regs = 1;          // registers of the longest distance tape: sizes the workers' VMs
     std::vector<Instr> shade_code;  // the shading program without the distance output's code
+
+    // The shading program's material outputs as a tape (shade_code, the program's registers).
+    TapeView shade_tape() const {
+        const Program& p = scene->shading;
+        return TapeView{shade_code.data(), static_cast<uint32_t>(shade_code.size()), p.outputs.data(),
+                        static_cast<uint32_t>(p.outputs.size()), p.num_regs};
+    }
 
     Frame(const CompiledScene& s, RenderPlan p)
         : RenderPlan(std::move(p)), scene(&s), camera(s.camera, std::max(s.render.width, 1), std::max(s.render.height, 1)) {}

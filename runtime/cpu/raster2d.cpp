@@ -45,7 +45,7 @@ constexpr int kMaxDepth = 12;  // 2^12 * 8 pixels: far beyond any image size we 
 static_assert(kLeaf * kLeaf == kBatch);
 
 struct Scratch {
-    Scratch(const Program& prog, const Tape& root) : ev(prog), root_regs(root.num_regs), root_choices(root.choices) {
+    Scratch(const Program& prog, const Tape& root) : ev(prog.num_regs), root_regs(root.num_regs), root_choices(root.choices) {
         iv.resize(kMaxDepth);
         tapes.resize(kMaxDepth + 1);
         batch.resize(kMaxDepth);
@@ -55,7 +55,7 @@ struct Scratch {
         if (!p) p = std::make_unique<IntervalEvaluator>(root_regs, root_choices);
         return *p;
     }
-    Evaluator ev;
+    BatchVM ev;  // every tape of the quadtree, sized by the root's registers
     uint32_t root_regs, root_choices;
     std::vector<std::unique_ptr<IntervalEvaluator>> iv;  // per depth: the choices stay readable while children run
     std::vector<Tape> tapes;                             // per depth: the tape of the tile being processed
@@ -114,7 +114,7 @@ void fill(Ctx& c, int x0, int y0, int x1, int y1, float v) {
 }
 
 // Pixels of the tile [x0, x0 + size)^2 (clipped), 8 x 8 pixels per VM batch.
-void leaf(Ctx& c, Scratch& s, const Instr* code, size_t count, uint16_t out, int x0, int y0, int size) {
+void leaf(Ctx& c, Scratch& s, const TapeView& tape, int x0, int y0, int size) {
     for (int by = y0; by < std::min(y0 + size, c.h); by += 8)
         for (int bx = x0; bx < std::min(x0 + size, c.w); bx += 8) {
             const int x1 = std::min(bx + 8, c.w), y1 = std::min(by + 8, c.h);
@@ -137,8 +137,8 @@ void leaf(Ctx& c, Scratch& s, const Instr* code, size_t count, uint16_t out, int
                         ys[r * cols + q] = yc[r];
                     }
             }
-            s.ev.eval_code(code, count, xs, ys, zs, n, c.time);
-            const float* d = s.ev.reg_data(out);
+            s.ev.eval(tape, xs, ys, zs, n, c.time);
+            const float* d = s.ev.output(tape);
             if (cols == 8 && rows == 8) {
                 for (int r = 0; r < 8; ++r) {
                     float* row = c.px + size_t(by + r) * c.w + bx;
@@ -225,7 +225,7 @@ void descend(Ctx& c, Scratch& s, int depth, const Children& ch) {
     if (ch.leaves) {
         for (int q = 0; q < ch.m; ++q) {
             const int k = ch.todo[q];
-            leaf(c, s, bs.code(k), bs.len[size_t(k)], bs.out[size_t(k)], ch.cx[k], ch.cy[k], child);
+            leaf(c, s, bs.view(k), ch.cx[k], ch.cy[k], child);
         }
         return;
     }
@@ -251,7 +251,7 @@ void descend(Ctx& c, Scratch& s, int depth, const Children& ch) {
 // The tile [x0, x0 + size)^2 (clipped to the image) at depth `depth`, whose tape is `t`.
 void process(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0) {
     if (size_t(depth) + 1 == c.sizes.size()) {
-        leaf(c, s, t.code.data(), t.code.size(), t.out, x0, y0, c.sizes[size_t(depth)]);
+        leaf(c, s, t.view(), x0, y0, c.sizes[size_t(depth)]);
         return;
     }
     Children ch;

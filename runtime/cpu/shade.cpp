@@ -79,12 +79,12 @@ void Worker::compute_materials(const RaySet& h) {
     for (size_t i0 = 0; i0 < n; i0 += kBatch) {
         const int m = static_cast<int>(std::min<size_t>(kBatch, n - i0));
         if (shade_) {
-            const std::vector<Instr>& code = f_.shade_code;
-            shade_->eval_code(code.data(), code.size(), h.ox.data() + i0, h.oy.data() + i0, h.oz.data() + i0, m, f_.time);
+            const TapeView tape = f_.shade_tape();
+            shade_->eval(tape, h.ox.data() + i0, h.oy.data() + i0, h.oz.data() + i0, m, f_.time);
             stats.shading_points += static_cast<uint64_t>(m);
-            stats.shading_instructions += static_cast<uint64_t>(m) * code.size();
+            stats.shading_instructions += static_cast<uint64_t>(m) * tape.len;
             for (int c = 0; c < kMatOut; ++c) {
-                const float* o = shade_->output(c + 1);
+                const float* o = shade_->output(tape, static_cast<uint32_t>(c + 1));
                 for (int i = 0; i < m; ++i) mat_[(i0 + i) * kMatOut + c] = o[i];
             }
         } else {

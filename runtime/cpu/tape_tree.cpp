@@ -74,8 +74,7 @@ struct TreeScratch {
     uint32_t regs = 0, choices = 0;
     BatchScratch bs;
     uint64_t boxes = 0;
-    std::unique_ptr<Program> vm_regs;  // sizes `vm` (eval_code only)
-    std::unique_ptr<Evaluator> vm;
+    std::unique_ptr<BatchVM> vm;  // grows to the longest tape it runs
     IntervalEvaluator& get(uint32_t r, uint32_t c) {
         if (!iv || r > regs || c > choices) {
             regs = std::max(regs, r);
@@ -84,13 +83,8 @@ struct TreeScratch {
         }
         return *iv;
     }
-    Evaluator& point_vm(uint32_t r) {
-        if (!vm || r > vm_regs->num_regs) {
-            vm.reset();
-            vm_regs = std::make_unique<Program>();
-            vm_regs->num_regs = std::max<uint32_t>(r, 64);
-            vm = std::make_unique<Evaluator>(*vm_regs);
-        }
+    BatchVM& point_vm() {
+        if (!vm) vm = std::make_unique<BatchVM>(64);
         return *vm;
     }
 };
@@ -219,9 +213,10 @@ void TreeBuilder::split(TreeScratch& s, uint32_t i) {
             cy[k] = 0.5f * (bx[2][k] + bx[3][k]);
             cz[k] = 0.5f * (bx[4][k] + bx[5][k]);
         }
-        Evaluator& vm = s.point_vm(c.tape.num_regs);
-        vm.eval_code(c.tape.code.data(), c.tape.code.size(), cx, cy, cz, 8, time_);
-        std::copy_n(vm.reg_data(c.tape.out), 8, dc);
+        BatchVM& vm = s.point_vm();
+        const TapeView tape = c.tape.view();
+        vm.eval(tape, cx, cy, cz, 8, time_);
+        std::copy_n(vm.output(tape), 8, dc);
     }
     bool kept = false;
     uint64_t lanes = 0;

@@ -46,6 +46,8 @@ struct TapeTree {
         uint32_t len;
         uint16_t out;
         uint32_t node;       // its node (leaf 0: the root)
+        // The tape for an evaluator sized to the tree's max_regs.
+        TapeView view() const { return TapeView{code, len, &out, 1, 0}; }
     };
     glm::vec3 lo{0}, hi{0};
     std::vector<Node> nodes;

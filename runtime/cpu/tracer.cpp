@@ -147,7 +147,7 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
                             static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(f.samples));
             tree_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         }
-        f.regs.num_regs = std::max<uint32_t>(f.tree.max_regs, std::max<uint32_t>(scene.distance.num_regs, 1));
+        f.max_regs = std::max<uint32_t>(f.tree.max_regs, std::max<uint32_t>(scene.distance.num_regs, 1));
     });
 
     tbb::enumerable_thread_specific<std::unique_ptr<cpu::Worker>> workers;

@@ -21,8 +21,8 @@ constexpr int kConeEvents = 4;  // partial hits a cone composites (cone_march)
 
 class Worker {
 public:
-    explicit Worker(const Frame& f) : f_(f), T_(f.tree), dist_(f.regs) {
-        if (f.has_material) shade_ = std::make_unique<Evaluator>(f.scene->shading);
+    explicit Worker(const Frame& f) : f_(f), T_(f.tree), dist_(f.max_regs) {
+        if (f.has_material) shade_ = std::make_unique<BatchVM>(f.scene->shading.num_regs);
         lanes_ = std::make_unique<Lanes>();
         buckets_ = std::make_unique<Buckets>();
     }
@@ -35,8 +35,8 @@ public:
 private:
     const Frame& f_;
     const TapeTree& T_;
-    Evaluator dist_;  // runs tapes of T_ (eval_code) on a register file big enough for all
-    std::unique_ptr<Evaluator> shade_;
+    BatchVM dist_;  // runs the tapes of T_, its register file big enough for all
+    std::unique_ptr<BatchVM> shade_;
 
     // Scratch, reused tile after tile (no allocation once warm).
     RaySet rays_, next_, hits_, shadow_;
@@ -58,11 +58,11 @@ private:
     // Distances at n <= kWindow points that all lie in leaf `id`.
     void eval_leaf(uint32_t id, const float* x, const float* y, const float* z, int n, float* out) {
         const TapeTree::Leaf& lf = T_.leaves[id];
-        const Instr* code = lf.code;
+        const TapeView tape = lf.view();
         for (int i0 = 0; i0 < n; i0 += kBatch) {
             const int m = std::min(kBatch, n - i0);
-            dist_.eval_code(code, lf.len, x + i0, y + i0, z + i0, m, f_.time);
-            std::copy_n(dist_.reg_data(lf.out), m, out + i0);
+            dist_.eval(tape, x + i0, y + i0, z + i0, m, f_.time);
+            std::copy_n(dist_.output(tape), m, out + i0);
         }
         stats.distance_points += static_cast<uint64_t>(n);
         stats.distance_points_by[kind_] += static_cast<uint64_t>(n);
@@ -78,13 +78,13 @@ private:
         B.build(leaf, n);
         for (int b = 0; b < B.nb; ++b) {
             const TapeTree::Leaf& lf = T_.leaves[B.key_of[b]];
-            const Instr* code = lf.code;
+            const TapeView tape = lf.view();
             for (int j0 = B.start[b]; j0 < B.start[b + 1]; j0 += kBatch) {
                 const int m = std::min(kBatch, B.start[b + 1] - j0);
                 const uint16_t* ord = B.order + j0;
                 for (int j = 0; j < m; ++j) gx_[j] = x[ord[j]], gy_[j] = y[ord[j]], gz_[j] = z[ord[j]];
-                dist_.eval_code(code, lf.len, gx_, gy_, gz_, m, f_.time);
-                const float* d = dist_.reg_data(lf.out);
+                dist_.eval(tape, gx_, gy_, gz_, m, f_.time);
+                const float* d = dist_.output(tape);
                 for (int j = 0; j < m; ++j) out[ord[j]] = d[j];
             }
             const uint64_t cnt = static_cast<uint64_t>(B.start[b + 1] - B.start[b]);

@@ -48,14 +48,6 @@ public:
     }
     const float* output(int i) const { return reg_data(program_->outputs[static_cast<size_t>(i)]); }
 
-    // Runs `count` instructions of another tape on this register file (they must use at
-    // most max_regs() registers); read the result with reg_data(its output register).
-    // Prefer eval(TapeView).
-    void eval_code(const Instr* code, size_t count, const float* x, const float* y, const float* z, int n,
-                   float time = 0.0f) {
-        BatchVM::eval(TapeView{code, static_cast<uint32_t>(count)}, x, y, z, n, time);
-    }
-
     // Convenience: one point, first output.
     float eval1(float x, float y, float z, float time = 0.0f) {
         eval(&x, &y, &z, 1, time);

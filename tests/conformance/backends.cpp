@@ -70,8 +70,10 @@ std::vector<std::vector<float>> SimplifiedTape<S>::eval_in_boxes(const Program& 
                 const int m = int(std::min<size_t>(kBatch, q.size() - i));
                 float xs[kBatch], ys[kBatch], zs[kBatch];
                 for (int j = 0; j < m; ++j) xs[j] = q[i + j].x, ys[j] = q[i + j].y, zs[j] = q[i + j].z;
-                ev.eval_code(code, len, xs, ys, zs, m, time);
-                out[at + size_t(l)].insert(out[at + size_t(l)].end(), ev.reg_data(res), ev.reg_data(res) + m);
+                const uint16_t out_reg = uint16_t(res);
+                const TapeView tape{code, uint32_t(len), &out_reg, 1, 0};
+                ev.eval(tape, xs, ys, zs, m, time);
+                out[at + size_t(l)].insert(out[at + size_t(l)].end(), ev.output(tape), ev.output(tape) + m);
             }
         }
     }
