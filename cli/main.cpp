@@ -291,10 +291,9 @@ int cmd_compile(Args& a) {
         LoweredScene ls = lower_scene(*s.graph, s);
         std::vector<NodeId> roots{ls.distance, ls.shading_distance};
         std::vector<std::string> names{"distance", "shading.d"};
-        const char* ch[] = {"r", "g", "b", "specular", "shininess", "reflect", "transparency", "ior", "emit_r", "emit_g", "emit_b"};
         for (int i = 0; i < kMatChannels; ++i) {
             roots.push_back(ls.material[i]);
-            names.push_back(std::string("shading.") + ch[i]);
+            names.push_back(std::string("shading.") + kMatChannelInfo[i].output);
         }
         std::cout << dump_ir(*s.graph, roots, names);
         return 0;

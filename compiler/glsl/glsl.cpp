@@ -67,7 +67,9 @@ Parts generate(const Scene& scene) {
     LoweredScene ls = lower_scene(g, scene);
     Program dist = codegen(g, {ls.distance}, {"d"});
     std::vector<NodeId> mroots(ls.material.begin(), ls.material.end());
-    Program mat = codegen(g, mroots, {"r", "g", "b", "specular", "shininess", "reflect", "transparency", "ior", "emit_r", "emit_g", "emit_b"});
+    std::vector<std::string> mnames;
+    for (const MatChannelInfo& ch : kMatChannelInfo) mnames.push_back(ch.output);
+    Program mat = codegen(g, mroots, mnames);
 
     // Settings as one more program (constants unless they depend on time).
     auto node = [&](NodeId n, float dflt) { return n == kNoNode ? g.constant(dflt) : n; };
@@ -182,13 +184,11 @@ Parts generate(const Scene& scene) {
     fs.var_prefix = "m";
     fs.finish = [](const std::vector<std::string>& o) {
         // Channels that are not a plain name or number get a named local, for readability.
-        static const char* names[kMatChannels] = {"red", "green", "blue", "specular", "shininess", "reflectance", "transparency",
-                                                  "ior", "emit_red", "emit_green", "emit_blue"};
         std::vector<std::string> lines, v(o.begin(), o.end());
         for (int i = 0; i < kMatChannels; ++i)
             if (v[i].find_first_of(" (") != std::string::npos) {
-                lines.push_back(fmt::format("float {} = {};", names[i], v[i]));
-                v[i] = names[i];
+                lines.push_back(fmt::format("float {} = {};", kMatChannelInfo[i].glsl, v[i]));
+                v[i] = kMatChannelInfo[i].glsl;
             }
         lines.push_back(fmt::format("return Material(vec3({}, {}, {}), {}, {}, {}, {}, {}, vec3({}, {}, {}));", v[0], v[1], v[2], v[3], v[4],
                                     v[5], v[6], v[7], v[8], v[9], v[10]));
