@@ -39,8 +39,6 @@
 #include "runtime/cpu/worker.hpp"
 
 namespace sdfc::cpu {
-namespace {
-}  // namespace
 
 // Lanes [0, n) whose point left their cached leaf box find their leaf.
 // Then returns in L.idx[0, return) the lanes that may jump (empty leaf for their sign).
@@ -174,6 +172,23 @@ inline bool Worker::skip_sphere(Lanes& L, int i, float slo, float te) {
     return true;
 }
 
+// The lane update of over-relaxed sphere tracing (rules.h sdf_relaxed_step) on sign * d,
+// for camera and bounce rays and (strict) hard shadow rays; `a` keeps the value the hit test
+// (sdf_relaxed_hit) reads.
+namespace {
+auto relaxed_update(int max_steps, float eps, bool strict) {
+    return [=](Lanes& L, int m, const float* d) {
+        for (int i = 0; i < m; ++i) {
+            const int st = ++L.steps[i];
+            float last;
+            L.done[i] = rules::sdf_relaxed_step(L.sign[i] * d[i], L.t0[i], L.tmax[i], strict, st, max_steps, eps, L.t[i], L.om[i],
+                                                L.pr[i], L.sl[i], last);
+            L.a[i] = last;
+        }
+    };
+}
+}  // namespace
+
 // Sphere tracing (outside rays on d, inside rays on -d). Results in t_, hit_, steps_.
 void Worker::march(const RaySet& rs) {
     if (f_.raw) return march_raw(rs, false);
@@ -185,17 +200,7 @@ void Worker::march(const RaySet& rs) {
     const float eps = f_.eps;
     run(
         rs, [](Lanes&, int) {},
-        [&](Lanes& L, int m, const float* d) {
-            // Over-relaxed sphere tracing (rules.h sdf_relaxed_step); a holds the value the
-            // hit test reads.
-            for (int i = 0; i < m; ++i) {
-                const int st = ++L.steps[i];
-                float last;
-                L.done[i] = rules::sdf_relaxed_step(L.sign[i] * d[i], L.t0[i], L.tmax[i], false, st, max_steps, eps, L.t[i], L.om[i],
-                                                    L.pr[i], L.sl[i], last);
-                L.a[i] = last;
-            }
-        },
+        relaxed_update(max_steps, eps, false),
         [&](Lanes& L, int i) {
             const uint32_t r = L.ray[i];
             const float s = L.a[i], path = L.t0[i] + L.t[i];
@@ -329,17 +334,7 @@ void Worker::shadow_hard(const RaySet& rs) {
     const float eps = f_.eps;
     run(
         rs, [](Lanes&, int) {},
-        [&](Lanes& L, int m, const float* d) {
-            // Over-relaxed like march() (plain near surfaces); a blocker only counts at a
-            // safe point (a point inside an occluder is one: it blocks).
-            for (int i = 0; i < m; ++i) {
-                const int st = ++L.steps[i];
-                float last;
-                L.done[i] = rules::sdf_relaxed_step(d[i], L.t0[i], L.tmax[i], true, st, max_steps, eps, L.t[i], L.om[i], L.pr[i],
-                                                    L.sl[i], last);
-                L.a[i] = last;
-            }
-        },
+        relaxed_update(max_steps, eps, true),  // a blocker counts only at a safe point (inside an occluder is one)
         [&](Lanes& L, int i) {
             const float d = L.a[i], path = L.t0[i] + L.t[i];
             const bool blocked =

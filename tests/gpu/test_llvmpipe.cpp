@@ -19,7 +19,7 @@ using namespace sdfc;
 using namespace sdfc::gpu_test;
 
 constexpr int kWidth = 160, kHeight = 90;
-constexpr double kMinPsnr = 40.0;
+constexpr double kMinPsnr = 45.0;
 
 }  // namespace
 
