@@ -114,7 +114,6 @@ Parts generate(const Scene& scene) {
         for (size_t i = 0; i < n; ++i) out[i] = eval_scalar(dist, x[i], y[i], z[i], 0.0f)[0];
     };
     const RenderPlan plan = resolve_plan(in);
-    const RenderSettings& rs = scene.render;
     const int nlights = scene.lights.empty() ? 2 : static_cast<int>(scene.lights.size());
 
     Parts out;

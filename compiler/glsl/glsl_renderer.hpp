@@ -32,7 +32,7 @@
 namespace sdfc::glsl {
 
 // compiler/render/rules.h as GLSL: its `#ifdef __cplusplus` blocks removed, SDF_FN dropped,
-// SDF_INOUT(T) / SDF_OUT(T) as `inout T` / `out T`.
+// SDF_INOUT(T) / SDF_OUT(T) as `inout T` / `out T`, SDF_AND / SDF_OR as && / ||.
 std::string shared_rules_glsl(std::string_view rules_h);
 
 }  // namespace sdfc::glsl

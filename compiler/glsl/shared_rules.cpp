@@ -27,7 +27,10 @@ std::string shared_rules_glsl(std::string_view rules_h) {
         out.push_back('\n');
     }
     static const std::regex fn(R"(SDF_FN )"), inout(R"(SDF_INOUT\((\w+)\))"), outp(R"(SDF_OUT\((\w+)\))");
+    static const std::regex and_(R"(\bSDF_AND\b)"), or_(R"(\bSDF_OR\b)");
     out = std::regex_replace(out, fn, "");
+    out = std::regex_replace(out, and_, "&&");
+    out = std::regex_replace(out, or_, "||");
     out = std::regex_replace(out, inout, "inout $1");
     out = std::regex_replace(out, outp, "out $1");
     // Leading blank lines (after the C++ prelude) go.
