@@ -481,3 +481,26 @@ TEST_CASE("glsl: shapes chosen by a condition on time", "[glsl]") {
     CHECK(test::first_error_line("field (p) -> { if (p.x > 0) sphere(1); p.x };") ==
           "test.sdf:1:24: error: a shape statement cannot depend on a condition on the point; use a field or min/max");
 }
+
+TEST_CASE("glsl: the shader carries the shared rules as GLSL and the plan's constants", "[glsl]") {
+    const std::string st = glsl_of_text("plane();\ntranslate([0, 1, 0]) sphere(1);", GlslTarget::Shadertoy);
+    // rules.h, turned into GLSL: no C++ left, each rule defined once.
+    for (const char* cxx : {"SDF_FN", "SDF_INOUT", "SDF_OUT(", " SDF_AND ", " SDF_OR ", "namespace", "#pragma", "glm::"}) {
+        INFO(cxx);
+        CHECK(st.find(cxx) == std::string::npos);
+    }
+    for (const char* rule : {"bool sdf_relaxed_step(", "bool sdf_raw_step(", "bool sdf_soft_step(", "bool sdf_cone_step(",
+                             "SdfCamera sdf_make_camera(", "float sdf_to_srgb(", "vec3 sdf_blinn_phong("}) {
+        INFO(rule);
+        const size_t at = st.find(rule);
+        CHECK(at != std::string::npos);
+        CHECK(st.find(rule, at + 1) == std::string::npos);
+    }
+    CHECK(st.find("inout float t, inout float om") != std::string::npos);
+    // The floor plane reaches the shader, with the plan's margin (that of the box of the rest, 3e-3).
+    CHECK(st.find("const int SDF_NUM_PLANES = 1;") != std::string::npos);
+    CHECK(st.find("const vec4 SDF_PLANES[1] = vec4[1](vec4(0.0, 1.0, 0.0, 0.003));") != std::string::npos);
+    CHECK(st.find("const bool SDF_PREMARCH = true;") != std::string::npos);
+    // No light in the script: the default rig, from the rules.
+    CHECK(st.find("sdf_key_light_dir(fwd, right, up)") != std::string::npos);
+}

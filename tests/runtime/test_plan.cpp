@@ -1,0 +1,153 @@
+// The render plan (compiler/render/plan.cpp) and the shared per-ray rules
+// (compiler/render/rules.h): settings resolve once, to the numbers both renderers read.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+
+#include "compiler/render/plan.hpp"
+#include "compiler/render/rules.h"
+#include "support.hpp"
+
+using namespace sdfc;
+
+namespace {
+
+RenderPlan plan_of(const std::string& src, bool baseline = false) {
+    auto c = test::compile_text(src);
+    if (c->scene.lights.empty()) c->cs.lights.clear();  // (compile_text gives tests the rig)
+    Evaluator ev(c->cs.distance);
+    return plan_for(c->cs, baseline, [&](const float* x, const float* y, const float* z, size_t n, float* out) {
+        for (size_t i = 0; i < n; ++i) out[i] = ev.eval1(x[i], y[i], z[i]);
+    });
+}
+
+}  // namespace
+
+TEST_CASE("plan: settings are clamped and defaulted once") {
+    // The script checks its own numbers; a CompiledScene made by hand (the library's users)
+    // is clamped by the plan.
+    auto c = test::compile_text("sphere(1);");
+    c->cs.render.width = 0, c->cs.render.height = 3, c->cs.render.samples = 5000, c->cs.render.max_steps = 0;
+    c->cs.render.max_bounces = 99;
+    const RenderPlan p = plan_for(c->cs, false, {});
+    CHECK(p.width == 1);
+    CHECK(p.height == 3);
+    CHECK(p.samples == 4096);
+    CHECK(p.offsets.size() == 4096);
+    CHECK(p.max_steps == 1);
+    CHECK(p.max_bounces == 64);
+    CHECK(p.min_weight == Approx(1e-3f / 4096.0f));
+    c->cs.render.epsilon = 0.0f, c->cs.render.max_distance = -1.0f;
+    const RenderPlan q = plan_for(c->cs, false, {});
+    CHECK(q.eps == 1e-4f);
+    CHECK(q.max_dist == 100.0f);
+}
+
+TEST_CASE("plan: sample offsets are a Hammersley set, the same for every renderer") {
+    const std::vector<glm::vec2> o = sample_offsets(4);
+    REQUIRE(o.size() == 4);
+    CHECK(o[0] == glm::vec2(0.125f, 0.125f));
+    CHECK(o[1] == glm::vec2(0.375f, 0.625f));
+    CHECK(o[2] == glm::vec2(0.625f, 0.375f));
+    CHECK(o[3] == glm::vec2(0.875f, 0.875f));
+    CHECK(sample_offsets(1) == std::vector<glm::vec2>{glm::vec2(0.5f, 0.5f)});
+}
+
+TEST_CASE("plan: the clip box has its margin; floor planes become half-spaces; baseline turns clipping off") {
+    const RenderPlan p = plan_of("sphere(1);");
+    CHECK(p.clip);
+    CHECK(p.lo.x == Approx(-1.0f - (2e-3f + 1e-3f)));
+    CHECK(p.hi.y == Approx(1.0f + 3e-3f));
+    CHECK(p.planes.empty());
+    CHECK(p.relax == 1.5f);
+    CHECK(p.premarch);
+
+    const RenderPlan f = plan_of("plane();\ntranslate([0, 1, 0]) sphere(1);");
+    CHECK_FALSE(f.clip);
+    REQUIRE(f.planes.size() == 1);
+    CHECK(f.planes[0].y == 1.0f);
+    CHECK(f.planes[0].w == Approx(2e-3f + 1e-3f));  // margin of the box of the rest, plus 1e-3
+    CHECK(f.solid_lo.y == Approx(0.0f - 3e-3f));
+
+    const RenderPlan b = plan_of("plane();\nsphere(1);", true);
+    CHECK(b.planes.empty());
+    CHECK_FALSE(b.clip);
+    CHECK(b.relax == 1.0f);
+    CHECK_FALSE(b.premarch);
+}
+
+TEST_CASE("plan: a script without lights gets the default rig, one with lights keeps them") {
+    const RenderPlan p = plan_of("sphere(1);");
+    CHECK(p.default_lights);
+    REQUIRE(p.lights.size() == 2);
+    CHECK(p.lights[0].directional);
+    CHECK(glm::length(p.lights[0].direction) == Approx(1.0f));
+    CHECK(p.lights[0].color == rules::sdf_key_light_color());
+    CHECK(p.lights[1].intensity == rules::sdf_fill_light_intensity());
+    const RenderPlan q = plan_of("light(position = [1, 2, 3], intensity = 5);\nsphere(1);");
+    CHECK_FALSE(q.default_lights);
+    REQUIRE(q.lights.size() == 1);
+    CHECK(q.lights[0].position == glm::vec3(1, 2, 3));
+}
+
+TEST_CASE("plan: cone anti-aliasing traces one cone per pixel; raw fields get no AO, a box and a Lipschitz estimate") {
+    const RenderPlan c = plan_of("render(aa = \"cone\", samples = 9);\nsphere(1);");
+    CHECK(c.cone);
+    CHECK(c.samples == 1);
+    CHECK_FALSE(c.premarch);
+    // A .vm-like raw field: the plan is resolved from a CompiledScene marked raw.
+    auto s = test::compile_text("field (p) -> length(p) * 3 - 3;");
+    s->cs.raw_field = true;
+    Evaluator ev(s->cs.distance);
+    const RenderPlan r = plan_for(s->cs, false, [&](const float* x, const float* y, const float* z, size_t n, float* out) {
+        for (size_t i = 0; i < n; ++i) out[i] = ev.eval1(x[i], y[i], z[i]);
+    });
+    CHECK(r.raw);
+    CHECK_FALSE(r.ao);
+    CHECK(r.clip);
+    CHECK(r.raw_lipschitz == Approx(4.5f).epsilon(0.02));  // |grad| = 3, times 1.5
+    CHECK(r.raw_max_step == Approx(glm::length(r.hi - r.lo) / 48.0f));
+}
+
+TEST_CASE("rules: material fallbacks are the material table's defaults") {
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    CHECK(rules::sdf_safe_shininess(nan) == kMatChannelInfo[kMatShininess].def);
+    CHECK(rules::sdf_safe_ior(nan) == kMatChannelInfo[kMatIor].def);
+    CHECK(rules::sdf_safe_ior(0.0f) == kMatChannelInfo[kMatIor].def);
+    CHECK(rules::sdf_safe_shininess(1e9f) == 1e4f);
+    CHECK(rules::sdf_nonneg(inf) == 1e30f);
+    CHECK(rules::sdf_nonneg(nan) == 0.0f);
+    CHECK(rules::sdf_clamp01(2.0f) == 1.0f);
+}
+
+TEST_CASE("rules: relaxed steps, hits and the raw-field bisection") {
+    // Far from anything: an over-relaxed step of 1.5 d.
+    float t = 1.0f, om = 1.5f, pr = 0.0f, sl = 0.0f, last = 0.0f;
+    CHECK_FALSE(rules::sdf_relaxed_step(2.0f, 0.0f, 100.0f, false, 1, 256, 1e-4f, t, om, pr, sl, last));
+    CHECK(t == 4.0f);
+    CHECK(last == 2.0f);
+    // The next sphere does not overlap the previous one: back to its boundary, omega 1.
+    CHECK_FALSE(rules::sdf_relaxed_step(0.5f, 0.0f, 100.0f, false, 2, 256, 1e-4f, t, om, pr, sl, last));
+    CHECK(om == 1.0f);
+    CHECK(t == 3.0f);  // the previous sphere's boundary: 1 + 2
+    CHECK(std::isinf(last));
+    // Under the threshold: a hit, moved on by its last distance.
+    float t2 = 3.0f, om2 = 1.0f, pr2 = 0.0f, sl2 = 0.0f, last2 = 0.0f;
+    CHECK(rules::sdf_relaxed_step(1e-5f, 0.0f, 100.0f, false, 3, 256, 1e-4f, t2, om2, pr2, sl2, last2));
+    const bool hit = rules::sdf_relaxed_hit(last2, t2, 3, 256, 1e-4f, 0.0f, 1e-3f);
+    CHECK(hit);
+    CHECK(rules::sdf_hit_t(t2, last2, hit) == 3.0f + 1e-5f);
+    // Raw field: a sign change brackets, bisection ends at the outside end.
+    float rt = 1.0f, prev = 0.5f, lo = 0.0f, hi = 0.0f, bisect = 0.0f;
+    bool rhit = false;
+    CHECK_FALSE(rules::sdf_raw_step(-1.0f, 0.0f, 10.0f, false, 1, 256, 1e-4f, 0.0f, 1e-3f, 1.0f, 1.0f, rt, prev, lo, hi, bisect, rhit));
+    CHECK(lo == 0.5f);
+    CHECK(hi == 1.0f);
+    CHECK(rt == 0.75f);
+    CHECK(rules::sdf_to_srgb(0.0031308f) == Approx(0.04045f).epsilon(1e-3));
+    CHECK(rules::sdf_to_srgb(2.0f) == 1.0f);
+    CHECK(rules::sdf_grid_x(0, 5) == -1.0f);
+    CHECK(rules::sdf_grid_x(4, 5) == 1.0f);
+    CHECK(rules::sdf_grid_y(0, 5) == 1.0f);
+}
