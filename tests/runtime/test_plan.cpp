@@ -54,7 +54,7 @@ TEST_CASE("plan: sample offsets are a Hammersley set, the same for every rendere
     CHECK(sample_offsets(1) == std::vector<glm::vec2>{glm::vec2(0.5f, 0.5f)});
 }
 
-TEST_CASE("plan: the clip box has its margin; floor planes become half-spaces; baseline turns clipping off") {
+TEST_CASE("plan: the clip box has its margin, floor planes become half-spaces, baseline turns clipping off") {
     const RenderPlan p = plan_of("sphere(1);");
     CHECK(p.clip);
     CHECK(p.lo.x == Approx(-1.0f - (2e-3f + 1e-3f)));
@@ -91,7 +91,7 @@ TEST_CASE("plan: a script without lights gets the default rig, one with lights k
     CHECK(q.lights[0].position == glm::vec3(1, 2, 3));
 }
 
-TEST_CASE("plan: cone anti-aliasing traces one cone per pixel; raw fields get no AO, a box and a Lipschitz estimate") {
+TEST_CASE("plan: cone anti-aliasing traces one cone per pixel, raw fields get no AO but a box and a Lipschitz estimate") {
     const RenderPlan c = plan_of("render(aa = \"cone\", samples = 9);\nsphere(1);");
     CHECK(c.cone);
     CHECK(c.samples == 1);
