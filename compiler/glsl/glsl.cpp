@@ -4,6 +4,7 @@
 //   render settings as constants          SDF_MAX_STEPS, SDF_EPSILON, ... (render(...) of the script)
 //   kRendererHead                         struct Material, struct SdfLight, setting globals (head.glsl)
 //   sdf_noise (only if the scene uses it) kGlslNoise, compiler/ir/noise.glsl
+//   sdf_powf, sdf_atan2 (if used)         kGlslPow, compiler/ir/pow.glsl
 //   float map(vec3 p)                     the distance program (compiler/bytecode/codegen.cpp)
 //   Material sdf_material(vec3 p)         the 11 material channels
 //   void sdf_settings()                   camera, lights, ambient, background (may use sdf_time)
@@ -170,6 +171,11 @@ Parts generate(const Scene& scene) {
     if (glsl::uses_op(dist, Op::Noise3) || glsl::uses_op(mat, Op::Noise3) || glsl::uses_op(set, Op::Noise3)) {
         c += "\n// Gradient noise, bit for bit the CPU's (compiler/ir/op_math.hpp).\n";
         c += om::kGlslNoise;
+    }
+    auto uses = [&](Op op) { return glsl::uses_op(dist, op) || glsl::uses_op(mat, op) || glsl::uses_op(set, op); };
+    if (uses(Op::Pow) || uses(Op::PowI) || uses(Op::Atan2)) {
+        c += "\n// pow and atan2 as the CPU computes them (compiler/ir/pow.glsl).\n";
+        c += om::kGlslPow;
     }
 
     glsl::FunctionSpec fs;

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "compiler/ir/noise.glsl.hpp"
+#include "compiler/ir/pow.glsl.hpp"
 
 namespace sdfc::om {
 

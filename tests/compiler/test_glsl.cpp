@@ -210,6 +210,7 @@ TEST_CASE("glsl: negative constants print as subtraction, never as '--'", "[glsl
 TEST_CASE("glsl: every opcode goes through the emitter as its opcodes.def template", "[glsl][opcodes]") {
     std::string all = "#version 300 es\nprecision highp float;\nprecision highp int;\nfloat sdf_time;\n";
     all += om::kGlslNoise;
+    all += om::kGlslPow;
     std::string sum;
     std::vector<std::string> single;
     for (int i = 0; i < kOpCount; ++i) {
@@ -236,7 +237,7 @@ TEST_CASE("glsl: every opcode goes through the emitter as its opcodes.def templa
     if (!err.empty()) {
         // Name the culprits.
         for (int i = 0; i < kOpCount; ++i) {
-            const std::string one = "#version 300 es\nprecision highp float;\nprecision highp int;\nfloat sdf_time;\n" + std::string(om::kGlslNoise) +
+            const std::string one = "#version 300 es\nprecision highp float;\nprecision highp int;\nfloat sdf_time;\n" + std::string(om::kGlslNoise) + std::string(om::kGlslPow) +
                                     single[i] + "out vec4 color;\nvoid main() { color = vec4(op_" + std::string(op_info(static_cast<Op>(i)).mnemonic) +
                                     "(gl_FragCoord.xyz)); }\n";
             const std::string e = validate(one, fmt::format("op_{}", i));
@@ -303,7 +304,8 @@ TEST_CASE("glsl: every sdf_ function a shader calls is defined in it, template h
     o.time = std::nullopt;
     for (const std::string& path : example_files()) scenes.emplace_back(path, load_scene(sm, path, o));
     for (const char* src : {"sphere(1);", "displace(0.1, 2) box(1);",
-                            "material(color = [noise([time, 1, 2]), 1, 1]) field (p) -> length(p) - 1;"})
+                            "material(color = [noise([time, 1, 2]), 1, 1]) field (p) -> length(p) - 1;",
+                            "field (p) -> pow(abs(p.x), 3) + atan2(p.y, p.z) - 1;"})
         scenes.emplace_back(src, interpret_source(sm, sm.add("scene.sdf", src), o));
     const std::set<std::string> helpers = template_helpers();
     std::set<std::string> used;
@@ -332,8 +334,8 @@ TEST_CASE("glsl: every sdf_ function a shader calls is defined in it, template h
 
 TEST_CASE("glsl: every function the renderer's .glsl files call is defined", "[glsl]") {
     // Builtins, constructors and keywords the renderer may use; a new builtin goes here.
-    const std::set<std::string> glsl = {"abs", "asin", "clamp", "cos", "cross", "dot", "exp", "floor", "isinf", "isnan",
-                                        "length", "max", "min", "mix", "normalize", "pow", "radians", "reflect", "refract",
+    const std::set<std::string> glsl = {"abs", "asin", "atan", "clamp", "cos", "cross", "dot", "exp", "floor", "isinf", "isnan",
+                                        "length", "max", "min", "mix", "mod", "normalize", "pow", "radians", "reflect", "refract",
                                         "sin", "sqrt", "tan", "uintBitsToFloat", "bool", "float", "int", "uint", "vec2",
                                         "vec3", "vec4", "ivec3", "uvec3", "if", "for", "while", "return"};
     // What compiler/glsl/glsl.cpp writes from the scene between kRendererHead and kRendererBody.
@@ -345,7 +347,8 @@ TEST_CASE("glsl: every function the renderer's .glsl files call is defined", "[g
     };
     const std::string rules = glsl::shared_rules_glsl(glsl::kSharedRules);
     const Part parts[] = {{"renderer", rules + std::string(glsl::kRendererHead) + std::string(glsl::kRendererBody), scene},
-                          {"noise", std::string(om::kGlslNoise), {}}};
+                          {"noise", std::string(om::kGlslNoise), {}},
+                          {"pow", std::string(om::kGlslPow), {}}};
     for (const Part& p : parts) {
         const std::set<std::string> defs = defined(p.text);
         for (const std::string& c : called(p.text)) {
