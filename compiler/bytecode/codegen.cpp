@@ -159,40 +159,4 @@ Program codegen(const Graph& g, const std::vector<NodeId>& roots, const std::vec
     return p;
 }
 
-std::string disassemble(const Program& p) {
-    std::string out = fmt::format("; {} instructions, {} registers\n", p.code.size(), p.num_regs);
-    for (size_t i = 0; i < p.code.size(); ++i) {
-        const Instr& in = p.code[i];
-        const OpInfo& info = op_info(in.op);
-        std::string line = fmt::format("{:04}  {:<9} r{}", i, info.mnemonic, in.out);
-        const uint16_t ops[3] = {in.a, in.b, in.c};
-        for (int j = 0; j < info.arity; ++j) line += fmt::format(", r{}", ops[j]);
-        if (info.has_imm) line += fmt::format(", {}", in.k);
-        if (i < p.locs.size() && p.locs[i].known()) line = fmt::format("{:<44}; line {}", line, p.locs[i].line);
-        out += line;
-        out += '\n';
-    }
-    for (size_t i = 0; i < p.outputs.size(); ++i)
-        out += fmt::format("; output {} = r{}\n", p.output_names[i], p.outputs[i]);
-    return out;
-}
-
-std::vector<float> eval_scalar(const Program& p, float x, float y, float z, float time) {
-    std::vector<float> r(p.num_regs, 0.0f);
-    for (const Instr& in : p.code) {
-        float v;
-        switch (in.op) {
-            case Op::VarX: v = x; break;
-            case Op::VarY: v = y; break;
-            case Op::VarZ: v = z; break;
-            case Op::Time: v = time; break;
-            default: v = eval_op(in.op, r[in.a], r[in.b], r[in.c], in.k);
-        }
-        r[in.out] = v;
-    }
-    std::vector<float> out;
-    for (uint16_t o : p.outputs) out.push_back(r[o]);
-    return out;
-}
-
 }  // namespace sdfc
