@@ -91,26 +91,11 @@ float cosf_(float x) { return std::cos(x); }
 
 // Unknown intervals. Invariant: if a point of the box may give NaN, or the interval is
 // unknown, both ends are NaN; NaN ends never decide a choice (comparisons are false). An
-// op keeps it by adding z (0, or NaN) to both ends, z from one of:
-//   Inputs  NaN when an operand has a NaN or infinite end (x * 0 is NaN for inf and NaN;
-//           a finite sum that overflows only makes the result unknown needlessly)
-//   Result  NaN when the result has a NaN or infinite end: enough for ops whose formulas
-//           carry a NaN or infinite operand end into the result (add, sub)
-//   B       NaN when operand b has one: min/max carry a's NaN ends (mn(NaN, x) is NaN)
-//           but not b's, and infinities are fine for them
-//   None    ops that carry NaN ends and make no NaN from finite or infinite operands
-//           (plus explicit domain checks: the root of a negative number, ...)
-enum class Poison { Inputs, Result, B, None };
+// op keeps it by adding z (0, or NaN) to both ends, z from its poison kind: opcodes.def's
+// poison column (OpPoison in compiler/ir/opcodes.hpp says what each kind means).
+using Poison = OpPoison;
 template <Op O>
-constexpr Poison poison_kind() {
-    switch (O) {
-        case Op::Add: case Op::Sub: case Op::AddI: case Op::SubI: return Poison::Result;
-        case Op::Min: case Op::Max: return Poison::B;
-        case Op::Const: case Op::VarX: case Op::VarY: case Op::VarZ: case Op::Time: case Op::Copy: case Op::Neg:
-        case Op::MinI: case Op::MaxI: case Op::Sqrt: return Poison::None;
-        default: return Poison::Inputs;
-    }
-}
+constexpr Poison poison_kind() { return kOpInfo[int(O)].poison; }
 
 // The interval semantics of op O: [al, ah] etc. in, [lo, hi] and the choice out.
 template <Op O>
@@ -396,7 +381,7 @@ Interval eval_interval(Op op, Interval a, Interval b, Interval c, float k, uint8
     Interval r{};
     uint8_t ch = kChoiceBoth;
     switch (op) {
-#define OP(name, mn, ar, imm, sem, glsl) \
+#define OP(name, mn, ar, imm, choice_, poison_, sem, glsl) \
     case Op::name: iv<Op::name>(a.lo, a.hi, b.lo, b.hi, c.lo, c.hi, k, r.lo, r.hi, ch); break;
 #include "compiler/ir/opcodes.def"
 #undef OP
@@ -462,7 +447,7 @@ void IntervalEvaluator::eval(const TapeView& t, const float* xlo, const float* x
         const float* chh = H + size_t(in.c) * kIvLanes;
         const float k = in.k;
         switch (in.op) {
-#define OP(name, mn, ar, imm, sem, glsl)                                                    \
+#define OP(name, mn, ar, imm, choice_, poison_, sem, glsl)                                                    \
     case Op::name:                                                                          \
         if constexpr (Op::name == Op::VarX) input(in, xlo, xhi);                            \
         else if constexpr (Op::name == Op::VarY) input(in, ylo, yhi);                       \

@@ -53,7 +53,7 @@ static inline void run(const Instr* code, const Instr* end, float* base, const f
     if (ip == end) return;
 #if defined(__GNUC__)
     static const void* const labels[] = {
-#define OP(name, mn, ar, imm, sem, glsl) &&L_##name,
+#define OP(name, mn, ar, imm, choice_, poison_, sem, glsl) &&L_##name,
 #include "compiler/ir/opcodes.def"
 #undef OP
     };
@@ -70,7 +70,7 @@ static inline void run(const Instr* code, const Instr* end, float* base, const f
     for (; ip != end; ++ip)
         switch (ip->op) {
 #endif
-#define OP(name, mn, ar, imm, sem, glsl)                                           \
+#define OP(name, mn, ar, imm, choice_, poison_, sem, glsl)                                           \
     SDFC_CASE(name) {                                                              \
         float* R = base + static_cast<size_t>(ip->out) * kBatch;                   \
         [[maybe_unused]] const float* A = base + static_cast<size_t>(ip->a) * kBatch; \
