@@ -315,7 +315,14 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
                 p.push_back(b.size(2));
                 break;
             }
-            case B::Cone: s.kind = ShapeKind::Cone; p = {b.size(0), b.size(1), b.size(2)}; break;
+            case B::Cone: {
+                s.kind = ShapeKind::Cone;
+                p = {b.size(0), b.size(1), b.size(2)};
+                bool all_zero = true;  // 0/0 in the distance: a NaN naming no parameter
+                for (NodeId n : p) all_zero &= gr.is_const(n) && gr.const_value(n) == 0.0f;
+                if (all_zero) fail(b.loc(0), "a cone needs a height h or a radius r1, r2 above zero (all three are 0)");
+                break;
+            }
             case B::Plane: {
                 s.kind = ShapeKind::Plane;
                 Vec3N n = b.vec3(0);
@@ -469,7 +476,9 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
             auto whole = [&](size_t i, int lo, int hi) {
                 float v = const_num(b.has(i) ? b.val(i) : Value::number(gr.constant(info.params[i].def[0])), b.loc(i), info.params[i].name);
                 if (!(v >= float(lo) && v <= float(hi)) || v != std::floor(v))
-                    fail(b.loc(i), fmt::format("render {} must be a whole number from {} to {}, not {}", info.params[i].name, lo, hi, v));
+                    fail(b.loc(i), fmt::format("render {} must be a whole number from {} to {}, not {}", info.params[i].name, lo, hi,
+                                               // whole numbers in full: 2147483648, not float's 2147483600
+                                               std::fabs(v) < 1e15f && v == std::floor(v) ? fmt::format("{}", (long long)v) : fmt::format("{}", v)));
                 return int(v);
             };
             r.width = whole(0, 1, 16384);
@@ -658,8 +667,16 @@ Value Interp::call_math(const BuiltinInfo& info, std::vector<Value>& args, const
         case B::Sin: return un(Op::Sin);
         case B::Cos: return un(Op::Cos);
         case B::Tan: return un(Op::Tan);
-        case B::Asin: return un(Op::Asin);
-        case B::Acos: return un(Op::Acos);
+        case B::Asin:
+        case B::Acos: {
+            // Like sqrt(-1): a constant out of the domain is an error; in a field (p varies)
+            // the argument is clamped to [-1, 1] (docs/language.md).
+            arity(1, 1);
+            for (int i = 0; i < args[0].n; ++i)
+                if (gr.is_const(args[0].c[i]) && !(std::fabs(gr.const_value(args[0].c[i])) <= 1.0f))
+                    fail(locs[0], fmt::format("{} of a number outside [-1, 1] ({})", info.name, gr.const_value(args[0].c[i])));
+            return un(info.id == B::Asin ? Op::Asin : Op::Acos);
+        }
         case B::Atan:
             if (args.size() == 2) return bin(Op::Atan2);  // GLSL's atan(y, x)
             return un(Op::Atan);
@@ -670,7 +687,18 @@ Value Interp::call_math(const BuiltinInfo& info, std::vector<Value>& args, const
                 if (gr.is_const(args[0].c[i]) && gr.const_value(args[0].c[i]) < 0) fail(locs[0], "sqrt of a negative number");
             return un(Op::Sqrt);
         }
-        case B::Pow: return bin(Op::Pow);
+        case B::Pow: {
+            arity(2, 2);
+            return componentwise2(args[0], args[1], loc, [&](NodeId x, NodeId y) {
+                if (gr.is_const(x) && gr.is_const(y)) {
+                    const float a = gr.const_value(x), e = gr.const_value(y);
+                    if (a < 0 && std::floor(e) != e)
+                        fail(locs[0], fmt::format("pow of a negative number ({}) to a fractional power ({}) is not a real number", a, e));
+                    if (a == 0 && e < 0) fail(locs[0], fmt::format("pow of zero to a negative power ({})", e));
+                }
+                return gr.binary(Op::Pow, x, y);
+            });
+        }
         case B::Exp: return un(Op::Exp);
         case B::Log: {
             arity(1, 1);
@@ -753,7 +781,23 @@ Value Interp::call_math(const BuiltinInfo& info, std::vector<Value>& args, const
         }
         case B::Normalize: {
             arity(1, 1);
+            bool all_const = true, all_zero = true;
+            for (int i = 0; i < args[0].n; ++i) {
+                all_const &= gr.is_const(args[0].c[i]);
+                all_zero &= gr.is_const(args[0].c[i]) && gr.const_value(args[0].c[i]) == 0.0f;
+            }
+            if (all_zero) fail(locs[0], "normalize of a zero vector");
             NodeId len = length(args[0]);
+            const bool degenerate = gr.is_const(len) && !(gr.const_value(len) > 0.0f && std::isfinite(gr.const_value(len)));
+            if (all_const && degenerate) {
+                // In double: the float length of [1e-30, 0, 0] underflows to 0.
+                double sq = 0;
+                for (int i = 0; i < args[0].n; ++i) sq += double(gr.const_value(args[0].c[i])) * gr.const_value(args[0].c[i]);
+                const double dl = std::sqrt(sq);
+                NodeId c[4];
+                for (int i = 0; i < args[0].n; ++i) c[i] = gr.constant(float(double(gr.const_value(args[0].c[i])) / dl));
+                return args[0].t == VT::Number ? Value::number(c[0]) : Value::vector(c, args[0].n);
+            }
             if (gr.is_const(len) && gr.const_value(len) == 0.0f) fail(locs[0], "normalize of a zero vector");
             return componentwise(args[0], loc, [&](NodeId x) { return gr.div(x, len); });
         }
