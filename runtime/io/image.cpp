@@ -75,31 +75,41 @@ std::unique_ptr<OIIO::ImageOutput> image_output_for(const std::string& path, OII
     return out;
 }
 
-// A full decode of what was encoded: a truncated or empty encoding is an error here, not a
-// broken file later. `mem` (when the reader takes an IOProxy) or the file `file`.
-void verify_encoding(const std::string& path, const std::string& file, const std::vector<unsigned char>* mem, int width,
-                     int height, int nch) {
-    std::unique_ptr<OIIO::ImageInput> in;
-    OIIO::Filesystem::IOMemReader reader(mem ? mem->data() : nullptr, mem ? mem->size() : 0);
-    if (mem) {
-        // OpenImageIO opens a file of the name it is given even with a proxy (a FIFO there
-        // would block): a name that cannot exist, with the extension that picks the reader.
-        const std::string none = "/dev/null/encoded" + fs::path(path).extension().string();
-        auto probe = OIIO::ImageInput::create(none, false, nullptr, &reader);
-        if (!probe || !probe->supports("ioproxy")) return;  // no reader from memory: the writer's word stands
-        in = OIIO::ImageInput::open(none, nullptr, &reader);
-    } else {
-        in = OIIO::ImageInput::open(file);
-    }
-    const std::string named = mem ? "/dev/null/encoded" + fs::path(path).extension().string() : file;
-    if (!in) throw std::runtime_error(write_error(path, "the encoded image does not read back (" + OIIO::geterror() + ")", named));
+// A full decode of what was encoded: a truncated, empty or broken encoding is found here,
+// not in a file later. decodes_in_memory: false also where no reader takes the bytes from
+// memory; verify_file throws "cannot write 'PATH': ..." (`file` named as PATH).
+bool decodes(OIIO::ImageInput* in, int width, int height, int nch, std::string* err) {
+    if (!in) return false;
     const OIIO::ImageSpec& spec = in->spec();
-    std::vector<float> px(size_t(spec.width) * spec.height * std::max(spec.nchannels, 1));
+    std::vector<float> px(size_t(std::max(spec.width, 0)) * std::max(spec.height, 0) * std::max(spec.nchannels, 1));
     bool ok = spec.width == width && spec.height == height && spec.nchannels >= std::min(nch, 3) &&
               in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data());
-    std::string err = ok ? std::string() : in->geterror();
+    if (!ok && err) *err = in->geterror();
     in->close();
-    if (!ok) throw std::runtime_error(write_error(path, "the encoded image does not read back" + (err.empty() ? "" : " (" + err + ")"), named));
+    return ok;
+}
+
+bool decodes_in_memory(const std::string& path, const std::vector<unsigned char>& mem, int width, int height, int nch) {
+    OIIO::Filesystem::IOMemReader reader(mem.data(), mem.size());
+    // OpenImageIO opens a file of the name it is given even with a proxy (a FIFO there
+    // would block): a name that cannot exist, with the extension that picks the reader.
+    const std::string none = "/dev/null/encoded" + fs::path(path).extension().string();
+    auto probe = OIIO::ImageInput::create(none, false, nullptr, &reader);
+    bool ok = probe && probe->supports("ioproxy");
+    probe.reset();
+    if (ok) {
+        auto in = OIIO::ImageInput::open(none, nullptr, &reader);
+        ok = decodes(in.get(), width, height, nch, nullptr);
+    }
+    (void)OIIO::geterror();
+    return ok;
+}
+
+void verify_file(const std::string& path, const std::string& file, int width, int height, int nch) {
+    auto in = OIIO::ImageInput::open(file);
+    std::string err = in ? std::string() : OIIO::geterror();
+    if (!decodes(in.get(), width, height, nch, &err))
+        throw std::runtime_error(write_error(path, "the encoded image does not read back" + (err.empty() ? "" : " (" + err + ")"), file));
 }
 
 // Encodes `data` (width*height*names.size() values of `type`) in the format `path`'s
@@ -123,19 +133,23 @@ void write_atomic(const std::string& path, int width, int height, const std::vec
         if (!ok) throw std::runtime_error(write_error(path, err.empty() ? OIIO::geterror() : err, temp));
     };
     std::vector<unsigned char> buf;
+    bool encoded = false;
     if (image_output_for(path)->supports("ioproxy")) {
         OIIO::Filesystem::IOVecOutput vec(buf);
         auto out = image_output_for(path, &vec);
         encode(*out, path, "");
         out.reset();
-        verify_encoding(path, "", &buf, width, height, int(names.size()));
-    } else {
+        encoded = decodes_in_memory(path, buf, width, height, int(names.size()));
+    }
+    if (!encoded) {
+        // No writer or no reader in memory, or a broken encoding there (this OpenImageIO's
+        // TIFF writer through a proxy): encoded to a file and decoded from it.
         const fs::path tmp_dir = fs::temp_directory_path();
         TempFile tmp(temp_path_for((tmp_dir / fs::path(path).filename()).string()));
         auto out = image_output_for(tmp.path());
         encode(*out, tmp.path(), tmp.path());
         out.reset();
-        verify_encoding(path, tmp.path(), nullptr, width, height, int(names.size()));
+        verify_file(path, tmp.path(), width, height, int(names.size()));
         std::ifstream in(tmp.path(), std::ios::binary);
         buf.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
         if (in.bad() || buf.empty()) throw std::runtime_error(write_error(path, "cannot read back the encoded image"));

@@ -343,3 +343,20 @@ TEST_CASE("eval --points is bounded and a device or directory or missing file or
     CHECK(r.status == 1);
     CHECK(r.err == "sdfc: error: eval takes --at X,Y,Z or --points FILE, not both\n");
 }
+
+TEST_CASE("every image format writes a file that reads back") {
+    // Found by tests/fuzz/fuzz_output.cpp: this OpenImageIO's TIFF writer through an
+    // in-memory proxy wrote a file without its image length.
+    const std::string dir = fresh_dir("formats");
+    std::string s = test::write_temp("formats.sdf", kScene);
+    for (const char* ext : {"png", "jpg", "exr", "hdr", "tif", "tiff", "bmp", "tga", "webp", "ppm", "sgi"}) {
+        INFO(ext);
+        const std::string out = dir + "/out." + ext;
+        auto r = run_sdfc("render " + q(s) + " -o " + q(out) + " --width 40 --height 24 --quiet");
+        CHECK(r.status == 0);
+        Image img = read_image(out);
+        CHECK(img.width == 40);
+        CHECK(img.height == 24);
+    }
+    CHECK(temps_in(dir) == "");
+}
