@@ -65,6 +65,12 @@ bool mount_tmpfs(const std::string& dir, int kb, bool read_only = false) {
     return true;
 }
 
+// Unmounts at the end of the scope, a failed REQUIRE included.
+struct Unmount {
+    std::string dir;
+    ~Unmount() { ::umount2(dir.c_str(), MNT_DETACH); }
+};
+
 // Fills the file system of `dir` to the last byte.
 void fill(const std::string& dir) {
     int fd = ::open((dir + "/filler").c_str(), O_WRONLY | O_CREAT, 0644);
@@ -82,6 +88,7 @@ const char* kScene = "camera(position = [0, 0.5, 4]);\nsphere(1);\ntranslate([0,
 TEST_CASE("a full disk: render slice JPEG and AOV side files fail with the reason and the old file stays") {
     const std::string dir = fresh_dir("full");
     if (!mount_tmpfs(dir, 64)) return;
+    Unmount unmount{dir};
     std::string s = test::write_temp("full.sdf", kScene);
     for (const char* name : {"keep.png", "keep.jpg", "keep.exr"}) {
         const std::string out = dir + "/" + name;
@@ -121,7 +128,6 @@ TEST_CASE("a full disk: render slice JPEG and AOV side files fail with the reaso
     CHECK(r.err.find("cannot write '" + glsl + "': No space left on device") != std::string::npos);
     CHECK(!fs::exists(glsl));
     CHECK(temps_in(dir) == "");
-    ::umount2(dir.c_str(), MNT_DETACH);
 }
 
 TEST_CASE("a character device or FIFO output is written through and a symlink stays a link") {
@@ -298,10 +304,10 @@ TEST_CASE("the output path and format are checked before the work naming the use
     const std::string ro = dir + "/ro";
     fs::create_directories(ro);
     if (mount_tmpfs(ro, 16, true)) {
+        Unmount unmount{ro};
         r = run_sdfc("render " + q(s) + " -o " + q(ro + "/x.png") + " --width 8 --height 8");
         CHECK(r.status == 1);
         CHECK(r.err == "sdfc: error: cannot write '" + ro + "/x.png': folder '" + ro + "': Read-only file system\n");
-        ::umount2(ro.c_str(), MNT_DETACH);
     }
     CHECK(temps_in(dir) == "");
 }

@@ -10,6 +10,7 @@
 // Run (as root, for the tmpfs and the device nodes; a plain folder otherwise; a TMPDIR of
 // its own keeps the scan for stray temporary files short):
 //                      mkdir -p /tmp/fz && TMPDIR=/tmp/fz build-fuzz/fuzz_output -max_total_time=600
+//                      (libFuzzer ends with _Exit: umount /tmp/fz/sdfc-fuzz-out-* afterwards)
 #include <fcntl.h>
 #include <sys/mount.h>
 #include <sys/stat.h>
