@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -10,10 +11,12 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <thread>
 
 #include <fmt/format.h>
 
 #include "cli/args.hpp"
+#include "cli/output_checks.hpp"
 #include "compiler/bytecode/compile.hpp"
 #include "compiler/glsl/glsl.hpp"
 #include "compiler/scene/lower.hpp"
@@ -117,14 +120,21 @@ std::string expand(std::string out, int frame, const std::string& name) {
 // the script's settings of each scene it compiles.
 using Overrides = std::vector<std::pair<std::string, std::optional<std::string>>>;
 
+bool ov_has(const Overrides& ov, const char* flag) {
+    for (auto& [k, v] : ov)
+        if (k == flag && v) return true;
+    return false;
+}
+
 void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
     std::vector<std::string> flat;
     for (auto& [k, v] : ov)
         if (v) { flat.push_back(k); flat.push_back(*v); }
     Args a(flat);
     bool sized = false;  // the size comes from flags, not (only) from the script
-    if (auto v = a.value("--width")) cs.render.width = Args::to_int("--width", *v, 1, 65536), sized = true;
-    if (auto v = a.value("--height")) cs.render.height = Args::to_int("--height", *v, 1, 65536), sized = true;
+    // The limits of render(width=, height=) and of slice.
+    if (auto v = a.value("--width")) cs.render.width = Args::to_int("--width", *v, 1, 16384), sized = true;
+    if (auto v = a.value("--height")) cs.render.height = Args::to_int("--height", *v, 1, 16384), sized = true;
     if (auto v = a.value("--samples")) cs.render.samples = Args::to_int("--samples", *v, 1, 4096), sized = true;
     if (auto v = a.value("--camera-position")) {
         auto f = Args::to_floats("--camera-position", *v, 3);
@@ -138,6 +148,11 @@ void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
         float f = Args::to_float("--fov", *v);
         if (!(f > 0 && f < 180)) throw UsageError("--fov must be between 0 and 180 degrees");
         cs.camera.fov = f;
+    }
+    // The flags' camera meets the script's rules (compiler/bytecode/compile.cpp).
+    if (ov_has(ov, "--camera-position") || ov_has(ov, "--camera-target")) {
+        std::string why = camera_problem(cs.camera);
+        if (!why.empty()) throw UsageError("--camera-position/--camera-target: " + why);
     }
     double px = double(cs.render.width) * cs.render.height * cs.render.samples;
     if (px > double(c.max_pixels)) {
@@ -153,7 +168,17 @@ CompiledScene build(SourceManager& sm, const std::string& path, Common& c, std::
     InterpretOptions o = c.interp;
     o.time = time;
     Scene s = load_scene(sm, path, o);
-    return compile_scene(s);
+    CompiledScene cs = compile_scene(s);
+    check_field_finite(s, cs);
+    return cs;
+}
+
+// More threads than the machine runs at once only add overhead (and TBB warns past its
+// limit): the request is capped there.
+int thread_count(const std::string& v) {
+    int n = Args::to_int("--threads", v, 1, 1024);
+    unsigned hw = std::thread::hardware_concurrency();
+    return hw > 0 ? std::min<int>(n, int(hw)) : n;
 }
 
 int cmd_render(Args& a) {
@@ -175,7 +200,7 @@ int cmd_render(Args& a) {
     if (!out) throw UsageError("render needs -o OUT");
     RenderOptions ro;
     ro.baseline = baseline;
-    if (threads) ro.threads = Args::to_int("--threads", *threads, 1, 1024);
+    if (threads) ro.threads = thread_count(*threads);
     if (aov) {
         std::stringstream ss(*aov);
         for (std::string item; std::getline(ss, item, ',');) {
@@ -209,6 +234,17 @@ int cmd_render(Args& a) {
     }
     if (scenes.size() > 1 && out->find("{name}") == std::string::npos)
         throw UsageError("rendering several scenes needs {name} in the output name");
+    // The outputs can be written (folder, format, not a directory...) before any work.
+    for (const std::string& path : scenes) {
+        std::string name = std::filesystem::path(path).stem().string();
+        for (int f : {f0, f1}) {
+            std::string target = expand(*out, f, name);
+            check_image_output(target);
+            check_not_input(target, path);
+            if (!is_exr(target))
+                for (const std::string& av : ro.aovs) check_image_output(aov_side_path(target, av));
+        }
+    }
     float base_time = time_s ? Args::to_float("--time", *time_s) : 0.0f;
     auto compile_frame = [&](SourceManager& sm, const std::string& path, int f) {
         float t = animated ? base_time + float(f) / fps : base_time;
@@ -238,6 +274,9 @@ int cmd_render(Args& a) {
             SourceManager sm;
             CompiledScene cs = compile_frame(sm, path, f);
             std::string target = expand(*out, f, name);
+            check_not_input(target, sm);
+            if (!is_exr(target))
+                for (const std::string& av : ro.aovs) check_not_input(aov_side_path(target, av), sm);
             // A progress bar with ETA on a terminal, for renders past a second; the summary
             // line below either way (unless --quiet).
             bool bar = false;
@@ -313,14 +352,14 @@ int cmd_eval(Args& a) {
     auto time_s = a.value("--time");
     std::string path = one_scene(a, "eval");
     if (!at && !points) throw UsageError("eval needs --at X,Y,Z or --points FILE");
+    if (at && points) throw UsageError("eval takes --at X,Y,Z or --points FILE, not both");
     std::vector<float> xs, ys, zs;
     if (at) {
         auto f = Args::to_floats("--at", *at, 3);
         xs.push_back(f[0]); ys.push_back(f[1]); zs.push_back(f[2]);
     }
     if (points) {
-        std::ifstream in(*points);
-        if (!in) throw UsageError(fmt::format("cannot open '{}'", *points));
+        std::istringstream in(read_bounded(*points, c.interp.limits.max_file_bytes));
         std::string line;
         int ln = 0;
         while (std::getline(in, line)) {
@@ -343,7 +382,7 @@ int cmd_eval(Args& a) {
         ev.eval(&xs[i], &ys[i], &zs[i], n, cs.time);
         for (int j = 0; j < n; ++j) out += fmt::format("{}\n", ev.output(0)[j] + 0.0f);  // + 0: no "-0"
     }
-    std::fwrite(out.data(), 1, out.size(), stdout);
+    write_stdout(out);
     return 0;
 }
 
@@ -373,8 +412,11 @@ int cmd_slice(Args& a) {
     if (h) so.height = Args::to_int("--height", *h, 1, 16384);
     if (double(so.width) * so.height > double(c.max_pixels))
         throw UsageError(fmt::format("{}x{} pixels is over the limit of {} (raise it with --max-pixels)", so.width, so.height, c.max_pixels));
+    check_image_output(*out);
+    check_not_input(*out, path);
     SourceManager sm;
     CompiledScene cs = build(sm, path, c, time_s ? Args::to_float("--time", *time_s) : 0.0f);
+    check_not_input(*out, sm);
     write_image(*out, render_slice(cs, so));
     return 0;
 }
@@ -391,13 +433,18 @@ int cmd_glsl(Args& a) {
         else if (*target == "html") t = GlslTarget::Html;
         else throw UsageError(fmt::format("--target takes shadertoy, glsl330 or html, not '{}'", *target));
     }
+    if (out) {
+        resolve_output(*out);
+        check_not_input(*out, path);
+    }
     SourceManager sm;
     InterpretOptions o = c.interp;
     o.time = std::nullopt;  // `time` becomes iTime
     Scene s = load_scene(sm, path, o);
+    if (out) check_not_input(*out, sm);
     std::string text = emit_glsl(s, t);
     if (!out) {
-        std::fwrite(text.data(), 1, text.size(), stdout);
+        write_stdout(text);
         return 0;
     }
     write_text_file(*out, text);
@@ -417,7 +464,7 @@ int cmd_bench(Args& a) {
     CompiledScene cs = build(sm, path, c, 0.0f);
     apply_overrides(cs, ov, c);
     RenderOptions ro;
-    if (threads) ro.threads = Args::to_int("--threads", *threads, 1, 1024);
+    if (threads) ro.threads = thread_count(*threads);
     ro.baseline = baseline;
     std::vector<double> ms;
     RenderStats stats;
@@ -497,6 +544,19 @@ int run(int argc, char** argv) {
     }
 }
 
+// Whatever a command printed must have reached standard output (a full disk, a closed
+// pipe end): flushed and checked here, and closed and checked at exit.
+int finish_stdout(int rc) {
+    errno = 0;
+    std::cout.flush();
+    const bool bad = !std::cout.good() || std::fflush(stdout) != 0 || std::ferror(stdout);
+    if (bad) {
+        sdfc::cli::report_stdout_error(errno);
+        return 1;
+    }
+    return rc;
+}
+
 }  // namespace
 
 // The command runs on a thread with a big stack: the interpreter and the compiler recurse
@@ -507,6 +567,12 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
     int rc = 1;
     const size_t stack = std::min(sdfc::max_thread_stack(), size_t(1) << 30);
-    if (!sdfc::run_on_new_stack(stack, [&] { rc = run(argc, argv); })) rc = run(argc, argv);
+    sdfc::install_temp_cleanup();
+    if (!sdfc::run_on_new_stack(stack, [&] { rc = finish_stdout(run(argc, argv)); })) rc = finish_stdout(run(argc, argv));
+    errno = 0;
+    if (std::fclose(stdout) != 0) {
+        sdfc::cli::report_stdout_error(errno);
+        return 1;
+    }
     return rc;
 }

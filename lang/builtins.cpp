@@ -306,6 +306,11 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
     if (info.kind == BuiltinKind::Shape) {
         Shape s{info.shape, loc};
         b.read(&s.params);
+        if (s.kind == ShapeKind::Cone) {  // 0/0 in the distance: a NaN naming no parameter
+            bool all_zero = true;
+            for (NodeId n : s.params) all_zero &= gr.is_const(n) && gr.const_value(n) == 0.0f;
+            if (all_zero) fail(b.loc(0), "a cone needs a height h or a radius r1, r2 above zero (all three are 0)");
+        }
         return Value::of_shape(make_shape(std::move(s)));
     }
     if (info.kind == BuiltinKind::Modifier) {
@@ -399,7 +404,9 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
             auto whole = [&](size_t i, int lo, int hi) {
                 float v = const_num(b.has(i) ? b.val(i) : Value::number(gr.constant(info.params[i].def[0])), b.loc(i), info.params[i].name);
                 if (!(v >= float(lo) && v <= float(hi)) || v != std::floor(v))
-                    fail(b.loc(i), fmt::format("render {} must be a whole number from {} to {}, not {}", info.params[i].name, lo, hi, v));
+                    fail(b.loc(i), fmt::format("render {} must be a whole number from {} to {}, not {}", info.params[i].name, lo, hi,
+                                               // whole numbers in full: 2147483648, not float's 2147483600
+                                               std::fabs(v) < 1e15f && v == std::floor(v) ? fmt::format("{}", (long long)v) : fmt::format("{}", v)));
                 return int(v);
             };
             r.width = whole(0, 1, 16384);
@@ -543,156 +550,6 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
         }
     }
     return make_shape(std::move(s));
-}
-
-Value Interp::call_math(const BuiltinInfo& info, std::vector<Value>& args, const std::vector<Loc>& locs, Loc loc) {
-    Graph& gr = *g;
-    using B = Builtin;
-    auto arity = [&](size_t lo, size_t hi) {
-        if (args.size() < lo || args.size() > hi) {
-            if (lo == hi) fail(loc, fmt::format("{} takes {} argument{}, not {}", info.name, lo, lo == 1 ? "" : "s", args.size()));
-            fail(loc, fmt::format("{} takes {} to {} arguments, not {}", info.name, lo, hi, args.size()));
-        }
-        for (size_t i = 0; i < args.size(); ++i)
-            if (!args[i].numeric())
-                fail(locs[i], fmt::format("argument {} of {} must be a number or a vector, not {}", i + 1, info.name, describe(args[i])));
-    };
-    auto un = [&](Op op) {
-        arity(1, 1);
-        return componentwise(args[0], loc, [&](NodeId x) { return gr.unary(op, x); });
-    };
-    auto bin = [&](Op op) {
-        arity(2, 2);
-        return componentwise2(args[0], args[1], loc, [&](NodeId x, NodeId y) { return gr.binary(op, x, y); });
-    };
-    auto need_vec = [&](size_t i) {
-        if (args[i].t != VT::Vector) fail(locs[i], fmt::format("argument {} of {} must be a vector, not {}", i + 1, info.name, describe(args[i])));
-    };
-    auto dot = [&](const Value& a, const Value& b) {
-        if (a.n != b.n) fail(loc, fmt::format("{} needs vectors of one size, not {} and {} components", info.name, a.n, b.n));
-        NodeId s = gr.mul(a.c[0], b.c[0]);
-        for (int i = 1; i < a.n; ++i) s = gr.add(s, gr.mul(a.c[i], b.c[i]));
-        return s;
-    };
-    auto length = [&](const Value& a) {
-        if (a.t == VT::Number) return gr.abs(a.c[0]);
-        if (a.n == 2) return gr.binary(Op::Length2, a.c[0], a.c[1]);
-        if (a.n == 3) return gr.ternary(Op::Length3, a.c[0], a.c[1], a.c[2]);
-        return gr.sqrt(dot(a, a));
-    };
-    switch (info.id) {
-        case B::Sin: return un(Op::Sin);
-        case B::Cos: return un(Op::Cos);
-        case B::Tan: return un(Op::Tan);
-        case B::Asin: return un(Op::Asin);
-        case B::Acos: return un(Op::Acos);
-        case B::Atan:
-            if (args.size() == 2) return bin(Op::Atan2);  // GLSL's atan(y, x)
-            return un(Op::Atan);
-        case B::Atan2: return bin(Op::Atan2);
-        case B::Sqrt: {
-            arity(1, 1);
-            for (int i = 0; i < args[0].n; ++i)
-                if (gr.is_const(args[0].c[i]) && gr.const_value(args[0].c[i]) < 0) fail(locs[0], "sqrt of a negative number");
-            return un(Op::Sqrt);
-        }
-        case B::Pow: return bin(Op::Pow);
-        case B::Exp: return un(Op::Exp);
-        case B::Log: {
-            arity(1, 1);
-            for (int i = 0; i < args[0].n; ++i)
-                if (gr.is_const(args[0].c[i]) && gr.const_value(args[0].c[i]) <= 0) fail(locs[0], "log of a number that is not positive");
-            return un(Op::Log);
-        }
-        case B::Abs: return un(Op::Abs);
-        case B::Sign: return un(Op::Sign);
-        case B::Floor: return un(Op::Floor);
-        case B::Ceil: return un(Op::Ceil);
-        case B::Fract: return un(Op::Fract);
-        case B::Mod: {
-            arity(2, 2);
-            return componentwise2(args[0], args[1], loc, [&](NodeId x, NodeId y) {
-                if (gr.is_const(y) && gr.const_value(y) == 0.0f) fail(locs[1], "mod by zero");
-                return gr.binary(Op::Mod, x, y);
-            });
-        }
-        case B::Min:
-        case B::Max: {
-            if (args.size() == 1 && args[0].t == VT::Vector) {
-                NodeId r = args[0].c[0];
-                for (int i = 1; i < args[0].n; ++i) r = gr.binary(info.id == B::Min ? Op::Min : Op::Max, r, args[0].c[i]);
-                return Value::number(r);
-            }
-            arity(2, 64);
-            Value r = args[0];
-            for (size_t i = 1; i < args.size(); ++i)
-                r = componentwise2(r, args[i], loc, [&](NodeId x, NodeId y) { return gr.binary(info.id == B::Min ? Op::Min : Op::Max, x, y); });
-            return r;
-        }
-        case B::Clamp: {
-            arity(3, 3);
-            Value lo = componentwise2(args[0], args[1], loc, [&](NodeId x, NodeId y) { return gr.max(x, y); });
-            return componentwise2(lo, args[2], loc, [&](NodeId x, NodeId y) { return gr.min(x, y); });
-        }
-        case B::Mix: {
-            arity(3, 3);
-            Value d = componentwise2(args[1], args[0], loc, [&](NodeId b, NodeId a) { return gr.sub(b, a); });
-            Value t = componentwise2(d, args[2], loc, [&](NodeId x, NodeId k) { return gr.mul(x, k); });
-            return componentwise2(args[0], t, loc, [&](NodeId a, NodeId x) { return gr.add(a, x); });
-        }
-        case B::Step: {
-            arity(2, 2);
-            // step(edge, x) = x < edge ? 0 : 1
-            return componentwise2(args[0], args[1], loc, [&](NodeId edge, NodeId x) {
-                return gr.sub(gr.constant(1), gr.binary(Op::Lt, x, edge));
-            });
-        }
-        case B::Smoothstep: {
-            arity(3, 3);
-            Value w = componentwise2(args[1], args[0], loc, [&](NodeId b, NodeId a) { return gr.sub(b, a); });
-            Value num_ = componentwise2(args[2], args[0], loc, [&](NodeId x, NodeId a) { return gr.sub(x, a); });
-            Value t = componentwise2(num_, w, loc, [&](NodeId n, NodeId d) {
-                if (gr.is_const(d) && gr.const_value(d) == 0.0f) fail(loc, "smoothstep with equal edges");
-                return gr.clamp(gr.div(n, d), gr.constant(0), gr.constant(1));
-            });
-            return componentwise(t, loc, [&](NodeId x) {
-                return gr.mul(gr.unary(Op::Square, x), gr.sub(gr.constant(3), gr.mul(gr.constant(2), x)));
-            });
-        }
-        case B::Length: arity(1, 1); return Value::number(length(args[0]));
-        case B::Distance: {
-            arity(2, 2);
-            Value d = componentwise2(args[0], args[1], loc, [&](NodeId x, NodeId y) { return gr.sub(x, y); });
-            return Value::number(length(d));
-        }
-        case B::Dot: arity(2, 2); need_vec(0); need_vec(1); return Value::number(dot(args[0], args[1]));
-        case B::Cross: {
-            arity(2, 2);
-            need_vec(0);
-            need_vec(1);
-            const Value &a = args[0], &b = args[1];
-            if (a.n != 3 || b.n != 3) fail(loc, "cross takes two 3-component vectors");
-            NodeId c[3] = {gr.sub(gr.mul(a.c[1], b.c[2]), gr.mul(a.c[2], b.c[1])),
-                           gr.sub(gr.mul(a.c[2], b.c[0]), gr.mul(a.c[0], b.c[2])),
-                           gr.sub(gr.mul(a.c[0], b.c[1]), gr.mul(a.c[1], b.c[0]))};
-            return Value::vector(c, 3);
-        }
-        case B::Normalize: {
-            arity(1, 1);
-            NodeId len = length(args[0]);
-            if (gr.is_const(len) && gr.const_value(len) == 0.0f) fail(locs[0], "normalize of a zero vector");
-            return componentwise(args[0], loc, [&](NodeId x) { return gr.div(x, len); });
-        }
-        case B::Radians: arity(1, 1); return componentwise(args[0], loc, [&](NodeId x) { return gr.mulc(x, 3.14159265358979f / 180.0f); });
-        case B::Degrees: arity(1, 1); return componentwise(args[0], loc, [&](NodeId x) { return gr.mulc(x, 180.0f / 3.14159265358979f); });
-        case B::Noise: {
-            arity(1, 1);
-            Vec3N p = vec3(args[0], locs[0], "the argument of noise", false);
-            return Value::number(gr.ternary(Op::Noise3, p[0], p[1], p[2]));
-        }
-        default: break;
-    }
-    fail(loc, fmt::format("internal: {} is not a math function", info.name));
 }
 
 }  // namespace sdfc

@@ -109,6 +109,10 @@ Scene load_vm(SourceManager&, const SourceFile& file) {
                 default:
                     v[i] = in.op.arity == 1 ? gr.unary(in.op.op, v[size_t(in.a)]) : gr.binary(in.op.op, v[size_t(in.a)], v[size_t(in.b)]);
             }
+            // A folded NaN or infinity (`ln` of -1) is an error on its own line, not on the
+            // line of the next operation that uses it.
+            if (gr.is_const(v[i]) && !std::isfinite(gr.const_value(v[i])))
+                throw CompileError(in.loc, fmt::format("this operation is not a finite number ({})", gr.const_value(v[i])));
         }
         return v.back();
     };

@@ -115,17 +115,25 @@ const SourceFile& SourceManager::load(const std::string& path, Loc from, size_t 
     auto st = std::filesystem::status(path, ec);
     if (!ec && std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
         throw CompileError(from, fmt::format("cannot read '{}': not a regular file", path));
+    if (!ec && std::filesystem::is_regular_file(st)) {
+        std::error_code sec;
+        const auto size = std::filesystem::file_size(path, sec);
+        if (!sec && size > max_bytes)
+            throw CompileError(from, fmt::format("'{}' is {} bytes, over the limit of {} bytes (--max-file-size)", path, size, max_bytes));
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) throw CompileError(from, fmt::format("cannot open '{}'", path));
-    in.seekg(0, std::ios::end);
-    std::streamoff size = in.tellg();
-    if (size < 0) throw CompileError(from, fmt::format("cannot read '{}' (is it a directory?)", path));
-    if (static_cast<size_t>(size) > max_bytes)
-        throw CompileError(from, fmt::format("'{}' is {} bytes, over the limit of {} bytes (--max-file-size)",
-                                             path, size, max_bytes));
-    in.seekg(0);
-    std::string text(static_cast<size_t>(size), '\0');
-    if (size > 0 && !in.read(text.data(), size)) throw CompileError(from, fmt::format("cannot read '{}'", path));
+    // Read up to the limit rather than trust a size: /proc files say 0 and have text.
+    std::string text;
+    char buf[1 << 16];
+    while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+        text.append(buf, size_t(in.gcount()));
+        if (text.size() > max_bytes)
+            throw CompileError(from, fmt::format("'{}' is over the limit of {} bytes (--max-file-size)", path, max_bytes));
+    }
+    if (in.bad()) throw CompileError(from, fmt::format("cannot read '{}'", path));
+    // A UTF-8 byte-order mark is no text: columns of the first line count from after it.
+    if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
     const SourceFile& f = add(path, std::move(text));
     check_source_text(f);
     return f;

@@ -66,6 +66,13 @@ public:
     // or for binary/invalid UTF-8 content or a file over `max_bytes`.
     const SourceFile& load(const std::string& path, Loc from = {}, size_t max_bytes = 16u << 20);
     const SourceFile& add(std::string path, std::string text);
+    // The path of every file loaded or added so far, the first one first (cli/: an output
+    // must not overwrite one of them).
+    std::vector<std::string> paths() const {
+        std::vector<std::string> out;
+        for (const auto& f : files_) out.push_back(f->path);
+        return out;
+    }
 
 private:
     std::deque<std::unique_ptr<SourceFile>> files_;

@@ -46,6 +46,26 @@ void check_constants(const Program& p) {
 
 }  // namespace
 
+std::string camera_problem(const ResolvedCamera& cam) {
+    auto finite = [](glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+    if (!finite(cam.position)) return "the camera position is not a finite number";
+    if (!finite(cam.target)) return "the camera target is not a finite number";
+    if (!finite(cam.up)) return "the camera up vector is not a finite number";
+    // Past this a float ray origin is coarser than 1e8 units: nothing of a scene can be seen.
+    constexpr float kFar = 1e15f;
+    for (int i = 0; i < 3; ++i) {
+        if (std::fabs(cam.position[i]) > kFar) return "the camera position is too far from the origin (at most 1e15 on each axis)";
+        if (std::fabs(cam.target[i]) > kFar) return "the camera target is too far from the origin (at most 1e15 on each axis)";
+    }
+    // A view direction and a right vector must exist, or every ray is NaN (in double: the
+    // squared length of a 1e15 view fits).
+    const glm::dvec3 view = glm::dvec3(cam.target) - glm::dvec3(cam.position), up(cam.up);
+    if (!(glm::length(view) > 0.0)) return "the camera's position and target are the same point";
+    if (!(glm::length(up) > 0.0) || !(glm::length(glm::cross(glm::normalize(view), glm::normalize(up))) > 1e-5))
+        return "the camera's up vector must not be zero or parallel to the view direction";
+    return {};
+}
+
 SceneBounds scene_bounds(const Scene& scene) {
     const Graph& g = *scene.graph;
     SceneBounds out;
@@ -81,12 +101,8 @@ CompiledScene compile_scene(const Scene& scene) {
     cs.camera.fov = constant(g, c.fov, c.loc, "the camera fov");
     cs.camera.orthographic = c.orthographic;
     cs.camera.ortho_height = constant(g, c.ortho_height, c.loc, "the camera ortho_height");
-    // A view direction and a right vector must exist, or every ray is NaN.
-    const glm::vec3 view = cs.camera.target - cs.camera.position;
-    if (!(glm::length(view) > 0.0f))
-        throw CompileError(c.loc, "the camera's position and target are the same point");
-    if (!(glm::length(glm::cross(glm::normalize(view), glm::normalize(cs.camera.up))) > 1e-5f))
-        throw CompileError(c.loc, "the camera's up vector must not be zero or parallel to the view direction");
+    const std::string why = camera_problem(cs.camera);
+    if (!why.empty()) throw CompileError(c.loc, why);
     for (const LightSettings& l : scene.lights) {
         ResolvedLight r;
         r.directional = l.directional;

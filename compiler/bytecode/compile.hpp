@@ -55,6 +55,10 @@ struct CompiledScene {
     float time = 0.0f;
 };
 
+// What is wrong with a camera (not finite, too far, position == target, up zero or along
+// the view), or "" when nothing is; compile_scene and the command line's camera flags.
+std::string camera_problem(const ResolvedCamera& cam);
+
 // Throws CompileError (at the setting's location) if a setting is not a constant.
 CompiledScene compile_scene(const Scene& scene);
 

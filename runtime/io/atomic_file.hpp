@@ -1,20 +1,61 @@
-// Writing output files safely: into a temporary file in the target's folder, then renamed
-// over the target, so a crash or a kill never leaves a partial file behind and an existing
-// output is replaced only by a complete one.
+// Writing output files safely. A regular file is written to a temporary file in its folder,
+// every write, the fsync and the close checked, then renamed over the target: a full disk,
+// a crash, a kill or an interrupt never leaves a partial file and an existing output is
+// replaced only by a complete one. A symlink keeps being a link (its target is replaced);
+// a character device or FIFO is written through, the way Unix tools do; anything else that
+// is not a regular file (a directory, a socket) is refused. Every error names the user's
+// path and the OS reason: "cannot write 'PATH': REASON".
 #pragma once
-#include <functional>
 #include <string>
+#include <string_view>
 
 namespace sdfc {
 
-// A temporary path beside `target` that keeps its extension (so format detection by
-// extension still works): "dir/out.png" -> "dir/.out.tmp-<pid>-<n>.png".
+// Where the bytes for a user's output path go (resolve_output).
+struct OutputTarget {
+    std::string path;            // as the user named it: every message names this
+    std::string file;            // the regular file to replace (a symlink resolved), or the node written through
+    bool write_through = false;  // a character device or a FIFO: opened and written, never replaced
+    bool exists = false;         // `file` exists (a regular file keeps its permission bits)
+    unsigned mode = 0;
+};
+
+// Checks a path can be written before any work is done: its folder exists and is writable,
+// it is not a directory or another node that cannot be written. Throws std::runtime_error.
+OutputTarget resolve_output(const std::string& path);
+
+// A temporary name beside `target` ("dir/.out.tmp-<pid>-<n>.png"), the extension kept and
+// the stem shortened so the name stays within NAME_MAX however long the target's name is.
 std::string temp_path_for(const std::string& target);
 
-// Calls write(temp) and renames temp onto target; removes temp and rethrows on failure.
-void write_atomically(const std::string& target, const std::function<void(const std::string& temp)>& write);
-
-// Text (GLSL, HTML) through write_atomically. Throws std::runtime_error on failure.
+// Writes `bytes` to `path` as described at the top. Throws std::runtime_error.
+void write_file(const std::string& path, std::string_view bytes);
+// Text (GLSL, HTML): write_file under another name.
 void write_text_file(const std::string& path, const std::string& text);
+
+// "cannot write 'PATH': REASON", with the temporary name (if any) replaced by PATH in REASON.
+std::string write_error(const std::string& path, std::string reason, const std::string& temp = "");
+
+// A temporary file that is removed when this goes out of scope (unless kept) and, while it
+// lives, by the SIGINT/SIGTERM/SIGHUP/SIGQUIT/SIGPIPE handlers of install_temp_cleanup().
+class TempFile {
+public:
+    explicit TempFile(std::string path);
+    ~TempFile();
+    TempFile(const TempFile&) = delete;
+    TempFile& operator=(const TempFile&) = delete;
+    const std::string& path() const { return path_; }
+    void keep();  // renamed away: nothing to remove any more
+
+private:
+    std::string path_;
+    int slot_ = -1;
+    bool keep_ = false;
+};
+
+// Installs the signal handlers that remove live temporary files before the process dies of
+// the signal (re-raised with its default action), and makes a file over the size limit
+// (SIGXFSZ) a write error instead of a kill. Call once, early in main.
+void install_temp_cleanup();
 
 }  // namespace sdfc

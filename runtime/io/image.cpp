@@ -1,10 +1,15 @@
 #include "runtime/io/image.hpp"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <memory>
 #include <filesystem>
 #include <stdexcept>
 #include <system_error>
@@ -53,24 +58,64 @@ uint8_t to_u8(float display) {
 
 float finite_or_zero(float v) { return std::isfinite(v) ? v : 0.0f; }
 
-// Writes `data` (width*height*names.size() values of `type`) to `path` through a temporary
-// file in the same folder, then renames it onto `path`.
+// Formats that are no image file: OpenImageIO's "null" writes nothing, "term" draws on a terminal.
+bool is_file_format(const char* name) { return std::strcmp(name, "null") != 0 && std::strcmp(name, "term") != 0; }
+
+std::unique_ptr<OIIO::ImageOutput> image_output_for(const std::string& path, OIIO::Filesystem::IOProxy* proxy = nullptr) {
+    const std::string ext = fs::path(path).extension().string();
+    if (ext.empty() || ext == ".")
+        throw std::runtime_error(write_error(path, "no extension to choose the image format from (.png, .jpg, .exr, .hdr, .tif, ...)"));
+    auto out = OIIO::ImageOutput::create(path, proxy);
+    (void)OIIO::geterror();  // clear: the message names nothing useful
+    if (!out || !is_file_format(out->format_name()))
+        throw std::runtime_error(write_error(path, "unknown image format '" + ext + "' (known: .png, .jpg, .exr, .hdr, .tif, .bmp, .tga, ...)"));
+    return out;
+}
+
+// A full decode of what was encoded: a truncated, empty or broken encoding is found here,
+// not in a file later. decodes_in_memory: false also where no reader takes the bytes from
+// memory; verify_file throws "cannot write 'PATH': ..." (`file` named as PATH).
+bool decodes(OIIO::ImageInput* in, int width, int height, int nch, std::string* err) {
+    if (!in) return false;
+    const OIIO::ImageSpec& spec = in->spec();
+    std::vector<float> px(size_t(std::max(spec.width, 0)) * std::max(spec.height, 0) * std::max(spec.nchannels, 1));
+    bool ok = spec.width == width && spec.height == height && spec.nchannels >= std::min(nch, 3) &&
+              in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data());
+    if (!ok && err) *err = in->geterror();
+    in->close();
+    return ok;
+}
+
+bool decodes_in_memory(const std::string& path, const std::vector<unsigned char>& mem, int width, int height, int nch) {
+    OIIO::Filesystem::IOMemReader reader(mem.data(), mem.size());
+    // OpenImageIO opens a file of the name it is given even with a proxy (a FIFO there
+    // would block): a name that cannot exist, with the extension that picks the reader.
+    const std::string none = "/dev/null/encoded" + fs::path(path).extension().string();
+    auto probe = OIIO::ImageInput::create(none, false, nullptr, &reader);
+    bool ok = probe && probe->supports("ioproxy");
+    probe.reset();
+    if (ok) {
+        auto in = OIIO::ImageInput::open(none, nullptr, &reader);
+        ok = decodes(in.get(), width, height, nch, nullptr);
+    }
+    (void)OIIO::geterror();
+    return ok;
+}
+
+void verify_file(const std::string& path, const std::string& file, int width, int height, int nch) {
+    auto in = OIIO::ImageInput::open(file);
+    std::string err = in ? std::string() : OIIO::geterror();
+    if (!decodes(in.get(), width, height, nch, &err))
+        throw std::runtime_error(write_error(path, "the encoded image does not read back" + (err.empty() ? "" : " (" + err + ")"), file));
+}
+
+// Encodes `data` (width*height*names.size() values of `type`) in the format `path`'s
+// extension names, checks it decodes, and writes it with write_file (checked, atomic).
+// In memory where the format's writer takes an IOProxy; otherwise through a temporary
+// file in the system's temporary folder, read back.
 void write_atomic(const std::string& path, int width, int height, const std::vector<std::string>& names,
                   OIIO::TypeDesc type, const void* data, bool linear) {
-    const fs::path target(path);
-    if (width <= 0 || height <= 0) throw std::runtime_error("cannot write '" + path + "': the image is empty");
-    // ".STEM.tmp-PID-N.EXT": the real extension last, so OpenImageIO picks the format.
-    const fs::path tmp = temp_path_for(path);
-    auto fail = [&](const std::string& why) {
-        std::error_code ec;
-        fs::remove(tmp, ec);
-        std::string msg = why;
-        while (!msg.empty() && (msg.back() == '\n' || msg.back() == ' ')) msg.pop_back();
-        throw std::runtime_error("cannot write '" + path + "': " + (msg.empty() ? std::string("unknown error") : msg));
-    };
-
-    auto out = OIIO::ImageOutput::create(tmp.string());
-    if (!out) fail("unsupported image format '" + target.extension().string() + "' (" + OIIO::geterror() + ")");
+    if (width <= 0 || height <= 0) throw std::runtime_error(write_error(path, "the image is empty"));
     OIIO::ImageSpec spec(width, height, static_cast<int>(names.size()), type);
     spec.channelnames = names;
     spec.alpha_channel = -1;
@@ -78,18 +123,35 @@ void write_atomic(const std::string& path, int width, int height, const std::vec
         if (names[i] == "Z") spec.z_channel = static_cast<int>(i);
     spec.attribute("oiio:ColorSpace", linear ? "Linear" : "sRGB");
     spec.attribute("Software", "sdfc");
-    if (!out->open(tmp.string(), spec)) fail(out->geterror());
-    bool ok = out->write_image(type, data);
-    std::string err = ok ? std::string() : out->geterror();
-    if (!out->close() && ok) {
-        ok = false;
-        err = out->geterror();
+    auto encode = [&](OIIO::ImageOutput& out, const std::string& name, const std::string& temp) {
+        bool ok = out.open(name, spec) && out.write_image(type, data);
+        std::string err = ok ? std::string() : out.geterror();
+        if (!out.close() && ok) ok = false, err = out.geterror();
+        if (!ok) throw std::runtime_error(write_error(path, err.empty() ? OIIO::geterror() : err, temp));
+    };
+    std::vector<unsigned char> buf;
+    bool encoded = false;
+    if (image_output_for(path)->supports("ioproxy")) {
+        OIIO::Filesystem::IOVecOutput vec(buf);
+        auto out = image_output_for(path, &vec);
+        encode(*out, path, "");
+        out.reset();
+        encoded = decodes_in_memory(path, buf, width, height, int(names.size()));
     }
-    out.reset();
-    if (!ok) fail(err);
-    std::error_code ec;
-    fs::rename(tmp, target, ec);
-    if (ec) fail(ec.message());
+    if (!encoded) {
+        // No writer or no reader in memory, or a broken encoding there (this OpenImageIO's
+        // TIFF writer through a proxy): encoded to a file and decoded from it.
+        const fs::path tmp_dir = fs::temp_directory_path();
+        TempFile tmp(temp_path_for((tmp_dir / fs::path(path).filename()).string()));
+        auto out = image_output_for(tmp.path());
+        encode(*out, tmp.path(), tmp.path());
+        out.reset();
+        verify_file(path, tmp.path(), width, height, int(names.size()));
+        std::ifstream in(tmp.path(), std::ios::binary);
+        buf.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        if (in.bad() || buf.empty()) throw std::runtime_error(write_error(path, "cannot read back the encoded image"));
+    }
+    write_file(path, std::string_view(reinterpret_cast<const char*>(buf.data()), buf.size()));
 }
 
 void write_side_file(const std::string& path, const Image& img, const AovPlane& a) {
@@ -137,12 +199,18 @@ void write_side_file(const std::string& path, const Image& img, const AovPlane& 
 
 }  // namespace
 
+void check_image_output(const std::string& path) {
+    resolve_output(path);
+    (void)image_output_for(path);
+}
+
 std::string aov_side_path(const std::string& path, const std::string& aov) {
     fs::path p(path);
     return (p.parent_path() / (p.stem().string() + "." + aov + ".png")).string();
 }
 
 void write_image(const std::string& path, const Image& img, const WriteOptions& opt) {
+    check_image_output(path);  // before any side file: a bad main path changes nothing
     const std::string ext = lower_ext(path);
     const size_t n = static_cast<size_t>(std::max(img.width, 0)) * std::max(img.height, 0);
     const int nc = std::clamp(img.channels, 1, 4);

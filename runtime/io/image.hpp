@@ -4,9 +4,9 @@
 // bmp/tga/... are written as 8-bit sRGB; exr and hdr as linear float. EXR carries the AOVs
 // as extra channels (`Z`, `N.x N.y N.z`, `steps`); every other format gets visualised side
 // files `STEM.depth.png`, `STEM.normal.png`, `STEM.steps.png` next to the image.
-// Every file is written to a temporary name in the target's folder and renamed onto the
-// target, so a crash never leaves a partial file and an existing output is only replaced by
-// a complete one.
+// Every file is encoded, decoded again as a check, and written by write_file
+// (runtime/io/atomic_file.hpp): a full disk, a crash or a kill never leaves a partial file,
+// an existing output is only replaced by a complete one, devices and FIFOs are written through.
 #pragma once
 #include <string>
 #include <string_view>
@@ -47,6 +47,11 @@ struct WriteOptions {
 // Throws std::runtime_error (with the path and the reason) on failure; the target is then
 // left as it was and no temporary file remains.
 void write_image(const std::string& path, const Image& img, const WriteOptions& opt = {});
+
+// The checks write_image makes before it encodes anything, for callers to make before the
+// work: the path can be written (resolve_output) and its extension names an image format
+// OpenImageIO writes. Throws std::runtime_error "cannot write 'PATH': REASON".
+void check_image_output(const std::string& path);
 
 // Reads any format OpenImageIO knows. 8-bit (and other integer) files are decoded from sRGB
 // to linear; float files are taken as linear. Channels named Z / N.x N.y N.z / steps become

@@ -1,0 +1,122 @@
+#include "cli/output_checks.hpp"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "cli/args.hpp"
+#include "runtime/eval/vm.hpp"
+
+namespace sdfc::cli {
+
+namespace fs = std::filesystem;
+
+bool is_exr(const std::string& path) {
+    std::string e = fs::path(path).extension().string();
+    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return e == ".exr";
+}
+
+namespace {
+
+bool same_file(const std::string& a, const std::string& b) {
+    std::error_code ec;
+    return fs::equivalent(a, b, ec) && !ec;  // false when either does not exist
+}
+
+}  // namespace
+
+void check_not_input(const std::string& out, const std::string& scene) {
+    if (same_file(out, scene)) throw std::runtime_error(fmt::format("cannot write '{}': it is the scene file '{}'", out, scene));
+}
+
+void check_not_input(const std::string& out, const SourceManager& sm) {
+    const std::vector<std::string> paths = sm.paths();
+    for (size_t i = 0; i < paths.size(); ++i)
+        if (same_file(out, paths[i]))
+            throw std::runtime_error(i == 0 ? fmt::format("cannot write '{}': it is the scene file '{}'", out, paths[i])
+                                            : fmt::format("cannot write '{}': the scene imports it ('{}')", out, paths[i]));
+}
+
+std::string read_bounded(const std::string& path, size_t max_bytes) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) throw UsageError(fmt::format("cannot read '{}': {}", path, std::strerror(errno)));
+    if (S_ISDIR(st.st_mode)) throw UsageError(fmt::format("cannot read '{}': {}", path, std::strerror(EISDIR)));
+    FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) throw UsageError(fmt::format("cannot read '{}': {}", path, std::strerror(errno)));
+    std::string data;
+    char buf[1 << 16];
+    for (;;) {
+        size_t n = std::fread(buf, 1, sizeof buf, f);
+        data.append(buf, n);
+        if (data.size() > max_bytes) {
+            std::fclose(f);
+            throw UsageError(fmt::format("'{}' is over the limit of {} bytes (raise it with --max-file-size)", path, max_bytes));
+        }
+        if (n < sizeof buf) break;
+    }
+    const bool failed = std::ferror(f);
+    const int err = errno;
+    std::fclose(f);
+    if (failed) throw UsageError(fmt::format("cannot read '{}': {}", path, std::strerror(err)));
+    return data;
+}
+
+void report_stdout_error(int err) {
+    static bool reported = false;
+    if (reported) return;
+    reported = true;
+    std::fprintf(stderr, "sdfc: error: cannot write to standard output: %s\n", err ? std::strerror(err) : "write error");
+}
+
+void write_stdout(std::string_view text) {
+    errno = 0;
+    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size()) report_stdout_error(errno);
+}
+
+namespace {
+
+bool has_user_field(const Shape& s) {
+    if (s.kind == ShapeKind::Field) return true;
+    for (const auto& c : s.children)
+        if (c && has_user_field(*c)) return true;
+    return false;
+}
+
+Loc first_known(const Shape& s) {
+    if (s.loc.known()) return s.loc;
+    for (const auto& c : s.children)
+        if (c) {
+            Loc l = first_known(*c);
+            if (l.known()) return l;
+        }
+    return {};
+}
+
+}  // namespace
+
+void check_field_finite(const Scene& s, const CompiledScene& cs) {
+    if (s.raw_field || !s.root || has_user_field(*s.root)) return;
+    Evaluator ev(cs.distance);
+    const glm::vec3 at[3] = {glm::vec3(0.0f), cs.camera.position, cs.camera.target};
+    float d0 = 0.0f;
+    for (int i = 0; i < 3; ++i) {
+        float d = ev.eval1(at[i].x, at[i].y, at[i].z, cs.time);
+        if (!std::isnan(d) && d > -INFINITY) return;  // +inf is an empty scene: nothing anywhere
+        if (i == 0) d0 = d;
+    }
+    throw CompileError(first_known(*s.root),
+                       fmt::format("the scene's distance is not a number ({} at the origin and at the camera): "
+                                   "a size or a scale overflows",
+                                   d0));
+}
+
+}  // namespace sdfc::cli
