@@ -18,6 +18,13 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
     using K = ast::ExprKind;
     check_stack(e.loc);
     g->set_loc(e.loc);
+    if (e.kind == K::Apply) return apply(e, env);
+    if (e.kind == K::BlockExpr) return eval_block(*e.block, env, env->field_scope);
+    return eval_rest(e, env);
+}
+
+[[gnu::noinline]] Value Interp::eval_rest(const ast::Expr& e, Env* env) {
+    using K = ast::ExprKind;
     switch (e.kind) {
         case K::Number: {
             if (!std::isfinite(float(e.number))) fail(e.loc, "this number is too large for a 32-bit float");
@@ -198,7 +205,7 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             return Value::vector(c, int(e.text.size()));
         }
         case K::Apply:
-            return apply(e, env);
+            return apply(e, env);  // (eval handles these two)
         case K::BlockExpr:
             return eval_block(*e.block, env, env->field_scope);
         case K::Field: {

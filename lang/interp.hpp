@@ -86,9 +86,15 @@ public:
     Scene run(const SourceFile& file);
 
     // --- evaluation (statements and blocks: interpreter.cpp; the rest: expressions.cpp)
+    // eval and exec are what nesting recurses through (blocks, modifiers, statements): they
+    // stay small frames and hand every other kind to eval_rest / exec_rest, whose frames
+    // (large under AddressSanitizer) are then not paid once per nesting level.
     Value eval(const ast::Expr& e, Env* env);
+    Value eval_rest(const ast::Expr& e, Env* env);
     Value eval_block(const ast::Block& b, Env* env, bool field_scope);
     void exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out);
+    void exec_rest(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out);
+    [[noreturn]] void bad_statement(const ast::Stmt& s, const Value& v);  // neither a shape nor a setting
     void exec_stmts(const std::vector<ast::StmtPtr>& stmts, Env* env, std::vector<ShapePtr>& out);
     Value call_value(const Value& callee, const std::vector<ast::Arg>& args, Env* env, Loc loc);
     Value call_user(const Callable& fn, const std::vector<ast::Arg>& args, Env* env, Loc loc);

@@ -196,6 +196,25 @@ struct IterItem {
 void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
     check_stack(s.loc);
     g->set_loc(s.loc);
+    if (s.kind == ast::StmtKind::Expr) {
+        Value v = eval(*s.value, env);
+        if (v.t == VT::Shape) {
+            out.push_back(v.shape);
+            return;
+        }
+        if (v.t == VT::None) return;  // settings statements
+        bad_statement(s, v);
+    }
+    exec_rest(s, env, out);
+}
+
+[[gnu::noinline]] void Interp::bad_statement(const ast::Stmt& s, const Value& v) {
+    if (v.t == VT::Modifier)
+        fail(s.value->loc, fmt::format("'{}' needs a shape to apply to, e.g. {}(...) sphere(1);", v.mod->name, v.mod->name));
+    fail(s.value->loc, fmt::format("this statement computes {} but does nothing with it (a statement must be a shape or a setting)", describe(v)));
+}
+
+[[gnu::noinline]] void Interp::exec_rest(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
     switch (s.kind) {
         case ast::StmtKind::Empty:
             return;
@@ -283,19 +302,8 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
                 if (!env->vars.count(name)) env->vars[name] = b;
             return;
         }
-        case ast::StmtKind::Expr: {
-            Value v = eval(*s.value, env);
-            if (v.t == VT::Shape) {
-                out.push_back(v.shape);
-            } else if (v.t == VT::None) {
-                // settings statements
-            } else if (v.t == VT::Modifier) {
-                fail(s.value->loc, fmt::format("'{}' needs a shape to apply to, e.g. {}(...) sphere(1);", v.mod->name, v.mod->name));
-            } else {
-                fail(s.value->loc, fmt::format("this statement computes {} but does nothing with it (a statement must be a shape or a setting)", describe(v)));
-            }
-            return;
-        }
+        case ast::StmtKind::Expr:
+            return;  // (exec handles it)
         case ast::StmtKind::If: {
             Value c = eval(*s.value, env);
             std::optional<bool> k = const_truth(c, s.value->loc);
