@@ -2,13 +2,14 @@
 //
 //   header comment (what it is, how to use it, the uniforms)
 //   render settings as constants          SDF_MAX_STEPS, SDF_EPSILON, ... (render(...) of the script)
+//   the per-ray rules                     compiler/render/rules.h as GLSL (shared_rules.cpp)
 //   kRendererHead                         struct Material, struct SdfLight, setting globals (head.glsl)
 //   sdf_noise (only if the scene uses it) kGlslNoise, compiler/ir/noise.glsl
 //   sdf_powf, sdf_atan2 (if used)         kGlslPow, compiler/ir/pow.glsl
 //   float map(vec3 p)                     the distance program (compiler/bytecode/codegen.cpp)
 //   Material sdf_material(vec3 p)         the 11 material channels
 //   void sdf_settings()                   camera, lights, ambient, background (may use sdf_time)
-//   kRendererBody                         the renderer, a twin of runtime/cpu/tracer.cpp (camera.glsl,
+//   kRendererBody                         the shader's scheduling around the shared rules (camera.glsl,
 //                                         marching.glsl, trace.glsl; see glsl_renderer.hpp)
 //   the target's entry point              mainImage / main
 //

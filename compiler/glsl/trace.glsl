@@ -161,7 +161,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
                 float bias = sdf_bias(SDF_EPSILON, P, path);
                 so = P + Nf * bias;
                 sdir = L;
-                float a0 = bias;  // (as runtime/cpu/tracer.cpp: edges do not shadow themselves)
+                float a0 = bias;  // (as runtime/cpu/shade.cpp: edges do not shadow themselves)
                 stmax = light.directional ? SDF_MAX_DIST : max(dist - bias, 0.0);
                 sdf_clip_ray(so, sdir, a0, stmax);
                 if (!(a0 <= stmax)) {  // the segment never enters the scene's box

@@ -48,7 +48,7 @@ inline float noise3(float px, float py, float pz) {
                    lerp(lerp(g(0, 0, 1), g(1, 0, 1), u), lerp(g(0, 1, 1), g(1, 1, 1), u), v), w);
     return r;
 }
-// Bound on |grad noise3| (measured over dense samples plus margin; see tests/test_lipschitz.cpp).
+// Bound on |grad noise3| (measured over dense samples plus margin; see tests/compiler/test_lipschitz.cpp).
 inline constexpr float kNoiseLipschitz = 3.0f;
 
 }  // namespace sdfc::om
