@@ -169,15 +169,7 @@ Parts generate(const Scene& scene) {
     c += glsl::shared_rules_glsl(glsl::kSharedRules);
     c += "\n";
     c += glsl::kRendererHead;
-    if (glsl::uses_op(dist, Op::Noise3) || glsl::uses_op(mat, Op::Noise3) || glsl::uses_op(set, Op::Noise3)) {
-        c += "\n// Gradient noise, bit for bit the CPU's (compiler/ir/op_math.hpp).\n";
-        c += om::kGlslNoise;
-    }
-    auto uses = [&](Op op) { return glsl::uses_op(dist, op) || glsl::uses_op(mat, op) || glsl::uses_op(set, op); };
-    if (uses(Op::Pow) || uses(Op::PowI) || uses(Op::Atan2)) {
-        c += "\n// pow and atan2 as the CPU computes them (compiler/ir/pow.glsl).\n";
-        c += om::kGlslPow;
-    }
+    c += glsl::op_helpers({&dist, &mat, &set});
 
     glsl::FunctionSpec fs;
     if (scene.root->kind == ShapeKind::Union) fs.quiet = scene.root->loc;

@@ -107,6 +107,25 @@ bool uses_op(const Program& prog, Op op) {
     return false;
 }
 
+std::string op_helpers(std::initializer_list<const Program*> progs) {
+    auto uses = [&](std::initializer_list<Op> ops) {
+        for (const Program* p : progs)
+            for (Op op : ops)
+                if (uses_op(*p, op)) return true;
+        return false;
+    };
+    std::string out;
+    if (uses({Op::Noise3})) {
+        out += "\n// Gradient noise, bit for bit the CPU's (compiler/ir/op_math.hpp).\n";
+        out += om::kGlslNoise;
+    }
+    if (uses({Op::Pow, Op::PowI, Op::Atan2})) {
+        out += "\n// pow and atan2 as the CPU computes them (compiler/ir/pow.glsl).\n";
+        out += om::kGlslPow;
+    }
+    return out;
+}
+
 std::string function(const Program& prog, const FunctionSpec& spec) {
     const size_t n = prog.code.size();
     // Definitions: which instruction last wrote each register, as the VM would run it.

@@ -3,6 +3,7 @@
 // Program as a GLSL function.
 #pragma once
 #include <functional>
+#include <initializer_list>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -40,6 +41,10 @@ std::string function(const Program& prog, const FunctionSpec& spec);
 
 // True when `prog` contains `op` (e.g. Noise3: the noise helper must be emitted).
 bool uses_op(const Program& prog, Op op);
+
+// The GLSL helpers that opcodes.def's templates call in these programs (sdf_noise;
+// sdf_powf and sdf_atan2), each with a comment line, in the order they must come.
+std::string op_helpers(std::initializer_list<const Program*> progs);
 
 // Text safe inside a `//` comment of any GLSL dialect and of an HTML <script>: ASCII only,
 // no line continuation, no "</".

@@ -10,8 +10,6 @@
 namespace sdfc {
 namespace {
 
-float max3(const glm::vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
-
 float radical_inverse2(uint32_t i) {
     i = (i << 16) | (i >> 16);
     i = ((i & 0x55555555u) << 1) | ((i & 0xAAAAAAAAu) >> 1);
@@ -28,8 +26,8 @@ float radical_inverse2(uint32_t i) {
 float estimate_lipschitz(const PlanInputs& in, const glm::vec3& lo, const glm::vec3& hi) {
     constexpr int kGrid = 16;
     const glm::vec3 ext = hi - lo;
-    if (!std::isfinite(max3(ext)) || !in.field) return 1.0f;
-    const float e = 1e-3f * std::max(max3(ext), 1e-6f);
+    if (!std::isfinite(rules::sdf_max3(ext)) || !in.field) return 1.0f;
+    const float e = 1e-3f * std::max(rules::sdf_max3(ext), 1e-6f);
     std::vector<float> fx, fy, fz;
     for (int k = 0; k < kGrid; ++k)
         for (int j = 0; j < kGrid; ++j)
@@ -115,14 +113,14 @@ RenderPlan resolve_plan(const PlanInputs& in) {
         }
     } else if (b.finite()) {
         // A little slack so rays start outside the surface's tolerance band.
-        const glm::vec3 margin = glm::vec3(1e-3f * std::max(max3(b.hi - b.lo), 0.0f) + 1e-3f);
+        const glm::vec3 margin = glm::vec3(1e-3f * std::max(rules::sdf_max3(b.hi - b.lo), 0.0f) + 1e-3f);
         p.lo = b.lo - margin;
         p.hi = b.hi + margin;
         p.clip = p.lo.x <= p.hi.x && p.lo.y <= p.hi.y && p.lo.z <= p.hi.z;
     } else if (!p.raw && !in.bounds.half_spaces.empty()) {
         const Bounds& sb = in.bounds.solid_bounds;
         const bool any = sb.lo.x <= sb.hi.x && sb.lo.y <= sb.hi.y && sb.lo.z <= sb.hi.z;
-        const float margin = 1e-3f * (any ? std::max(max3(sb.hi - sb.lo), 0.0f) : 0.0f) + 1e-3f;
+        const float margin = 1e-3f * (any ? std::max(rules::sdf_max3(sb.hi - sb.lo), 0.0f) : 0.0f) + 1e-3f;
         p.solid_lo = any ? sb.lo - margin : glm::vec3(1.0f);
         p.solid_hi = any ? sb.hi + margin : glm::vec3(-1.0f);
         for (const glm::vec4& q : in.bounds.half_spaces)

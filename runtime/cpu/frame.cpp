@@ -64,7 +64,7 @@ bool tree_root(const Frame& f, const CompiledScene& scene, const RenderOptions& 
         // the bounds. Points outside run the full program (leaf 0).
         constexpr float kPad = 0.25f;
         if (f.clip) {
-            const float pad = kPad + 0.05f * max3(f.hi - f.lo);
+            const float pad = kPad + 0.05f * rules::sdf_max3(f.hi - f.lo);
             root_lo = f.lo - pad;
             root_hi = f.hi + pad;
         } else {

@@ -12,7 +12,6 @@
 #include "compiler/render/camera.hpp"
 #include "compiler/render/plan.hpp"
 #include "compiler/render/rules.h"
-#include "runtime/cpu/float_ops.hpp"
 #include "runtime/cpu/tape_tree.hpp"
 #include "runtime/cpu/tracer.hpp"
 

@@ -283,11 +283,15 @@ void Worker::cone_march(const RaySet& rs) {
     trans_.assign(n, 1.0f);
     const int max_steps = f_.max_steps;
     const float foot_base = f_.camera.footprint_base(), foot_slope = f_.camera.footprint_slope();
+    // A partial hit the rules recorded (as event ev_n_[r] - 1).
+    auto store = [&](uint32_t r, bool emitted, float et, float ew) {
+        if (emitted) ev_t_[r * kConeEvents + ev_n_[r] - 1] = et, ev_w_[r * kConeEvents + ev_n_[r] - 1] = ew;
+    };
     auto emit = [&](uint32_t r, float t, float coverage) {
         bool emitted;
         float et, ew;
         rules::sdf_cone_emit(coverage, t, trans_[r], ev_n_[r], emitted, et, ew);
-        if (emitted) ev_t_[r * kConeEvents + ev_n_[r] - 1] = et, ev_w_[r * kConeEvents + ev_n_[r] - 1] = ew;
+        store(r, emitted, et, ew);
     };
     // Lane state: a = smallest d / r in the current edge zone (>= 1: none), b = its t,
     // w = 1 when the final state is a hit (rules.h sdf_cone_step).
@@ -301,7 +305,7 @@ void Worker::cone_march(const RaySet& rs) {
                 float et, ew;
                 L.done[i] = rules::sdf_cone_step(dist[i], L.t0[i], L.tmax[i], st, max_steps, f_.eps, foot_base, foot_slope, L.t[i],
                                                  L.a[i], L.b[i], trans_[r], ev_n_[r], emitted, et, ew, hit);
-                if (emitted) ev_t_[r * kConeEvents + ev_n_[r] - 1] = et, ev_w_[r * kConeEvents + ev_n_[r] - 1] = ew;
+                store(r, emitted, et, ew);
                 L.w[i] = hit ? 1.0f : 0.0f;
             }
         },

@@ -132,15 +132,15 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
             float F = 1.0f;
             if (glm::dot(T, T) > 0.0f) F = sdf_schlick(-glm::dot(T, Nf), ior);
             const glm::vec3 wr = W * F, wt = W * (1.0f - F);
-            if (max3(wr) >= min_w) push_secondary(next, P + Nf * bias, glm::reflect(D, Nf), h.t0[i], wr, h.prim[i], true);
-            if (max3(wt) >= min_w) push_secondary(next, P - Nf * bias, glm::normalize(T), h.t0[i], wt, h.prim[i], false);
+            if (rules::sdf_max3(wr) >= min_w) push_secondary(next, P + Nf * bias, glm::reflect(D, Nf), h.t0[i], wr, h.prim[i], true);
+            if (rules::sdf_max3(wt) >= min_w) push_secondary(next, P - Nf * bias, glm::normalize(T), h.t0[i], wt, h.prim[i], false);
             continue;
         }
         add_shaded(h.prim[i], W * glm::vec3(m[kMatEmitR], m[kMatEmitG], m[kMatEmitB]));
         const float refl = can_spawn ? m[kMatReflect] : 0.0f;
         const float tr = can_spawn ? m[kMatTransparency] : 0.0f;
         const glm::vec3 lw = W * ((1.0f - refl) * (1.0f - tr));
-        if (max3(lw) > 0.0f) {
+        if (rules::sdf_max3(lw) > 0.0f) {
             local_.push_back(static_cast<uint32_t>(i));
             lw_.insert(lw_.end(), {lw.x, lw.y, lw.z});
             lnx_.push_back(Nf.x), lny_.push_back(Nf.y), lnz_.push_back(Nf.z);
@@ -154,9 +154,9 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
             if (glm::dot(T, T) > 0.0f) F = sdf_schlick(-glm::dot(D, Nf), ior);
             w_refl += base * F;
             const glm::vec3 wt = base * (1.0f - F) * glm::vec3(m[kMatR], m[kMatG], m[kMatB]);
-            if (max3(wt) >= min_w) push_secondary(next, P - Nf * bias, glm::normalize(T), h.t0[i], wt, h.prim[i], true);
+            if (rules::sdf_max3(wt) >= min_w) push_secondary(next, P - Nf * bias, glm::normalize(T), h.t0[i], wt, h.prim[i], true);
         }
-        if (max3(w_refl) >= min_w) push_secondary(next, P + Nf * bias, glm::reflect(D, Nf), h.t0[i], w_refl, h.prim[i], false);
+        if (rules::sdf_max3(w_refl) >= min_w) push_secondary(next, P + Nf * bias, glm::reflect(D, Nf), h.t0[i], w_refl, h.prim[i], false);
     }
 
     const size_t nl = local_.size();
@@ -164,7 +164,7 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
 
     // Ambient (with occlusion).
     const glm::vec3 amb = f_.ambient;
-    if (max3(amb) > 0.0f) {
+    if (rules::sdf_max3(amb) > 0.0f) {
         ao_.assign(nl, 1.0f);
         if (f_.ao && !f_.raw) {
             px_.resize(nl * kAoTaps), py_.resize(nl * kAoTaps), pz_.resize(nl * kAoTaps), pd_.resize(nl * kAoTaps);
@@ -196,7 +196,7 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
     // Direct light, one batched shadow pass per light.
     for (const ResolvedLight& light : f_.lights) {
         const glm::vec3 radiance = light.color * light.intensity;
-        if (!(max3(radiance) > 0.0f) || !std::isfinite(max3(radiance))) continue;
+        if (!(rules::sdf_max3(radiance) > 0.0f) || !std::isfinite(rules::sdf_max3(radiance))) continue;
         glm::vec3 ldir = -light.direction;
         if (light.directional) {
             if (!(glm::dot(ldir, ldir) > 0.0f)) continue;

@@ -13,6 +13,8 @@
 #endif
 #include "runtime/cpu/tape_tree.hpp"
 
+#include "compiler/render/rules.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -21,7 +23,6 @@
 #include <memory>
 #include <queue>
 
-#include "runtime/cpu/float_ops.hpp"
 #include "runtime/eval/interval.hpp"
 #include "runtime/eval/vm.hpp"
 
@@ -56,14 +57,14 @@ bool settled(float ivlo, float ivhi) { return ivlo > 0.0f || ivhi < 0.0f; }
 // An empty or solid cell is still split when the surface is within kTreeNear of its size
 // (rays, normal and AO taps and soft shadows evaluate there).
 bool near_surface(const TreeCell& c) {
-    const float size = max3(c.hi - c.lo), d = c.ivlo > 0.0f ? c.ivlo : -c.ivhi;
+    const float size = rules::sdf_max3(c.hi - c.lo), d = c.ivlo > 0.0f ? c.ivlo : -c.ivhi;
     return d < kTreeNear * size;
 }
 
 bool want_split(const TreeCell& c) {
     if (c.ref_cell != kNone) return false;
     if (c.depth >= kTreeMaxDepth || c.tape.code.size() <= kTreeLeafTape || c.stall >= kTreeMaxStall) return false;
-    const float size = max3(c.hi - c.lo);
+    const float size = rules::sdf_max3(c.hi - c.lo);
     if (!(size > 0.0f) || !std::isfinite(size)) return false;
     return !settled(c.ivlo, c.ivhi) || near_surface(c);  // may hold the surface, or unknown (NaN)
 }
@@ -161,7 +162,7 @@ private:
     void consider(uint32_t i) {
         const TreeCell& c = cells_[i];
         if (!want_split(c)) return;
-        const double size = max3(c.hi - c.lo);
+        const double size = rules::sdf_max3(c.hi - c.lo);
         const double prio = static_cast<double>(c.tape.code.size()) * size * size * (settled(c.ivlo, c.ivhi) ? 0.25 : 1.0);
         queue_.emplace(prio, ~i);
     }

@@ -42,8 +42,7 @@ std::string shader(const Program& p) {
     spec.var_prefix = "v";
     std::string s = "#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp sampler2D;\n"
                     "uniform sampler2D sdf_points;\nuniform float sdf_time_in;\nfloat sdf_time;\nout vec4 sdf_bytes;\n";
-    if (glsl::uses_op(p, Op::Noise3)) s += om::kGlslNoise;
-    if (glsl::uses_op(p, Op::Pow) || glsl::uses_op(p, Op::PowI) || glsl::uses_op(p, Op::Atan2)) s += om::kGlslPow;
+    s += glsl::op_helpers({&p});
     s += glsl::function(p, spec);
     s += "void main() {\n"
          "    sdf_time = sdf_time_in;\n"
