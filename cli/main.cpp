@@ -442,7 +442,7 @@ int cmd_glsl(Args& a) {
     o.time = std::nullopt;  // `time` becomes iTime
     Scene s = load_scene(sm, path, o);
     if (out) check_not_input(*out, sm);
-    std::string text = emit_glsl(s, t);
+    std::string text = emit_glsl(s, t, sample_batch);
     if (!out) {
         write_stdout(text);
         return 0;

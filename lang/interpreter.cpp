@@ -152,7 +152,9 @@ Scene Interp::run(const SourceFile& file) {
     modules.push_back(ast::parse(file, ast::ParseOptions{opts.limits.max_nesting}));
     const ast::Module& m = *modules.back();
     Env* top = new_env(nullptr);
-    import_stack.push_back(std::filesystem::weakly_canonical(file.path).string());
+    std::error_code ec;  // the file was read, so only a race fails here; its own path stands in
+    auto key = std::filesystem::weakly_canonical(file.path, ec);
+    import_stack.push_back(ec ? file.path : key.string());
     std::vector<ShapePtr> shapes;
     std::vector<Diagnostic> errors;
     // Defs first, so a def may be used above the line that defines it.
@@ -267,7 +269,9 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             namespace fs = std::filesystem;
             fs::path base = fs::path(s.loc.file->path).parent_path();
             fs::path target = (base / s.name).lexically_normal();  // as diagnostics show it
-            std::string key = fs::weakly_canonical(target).string();
+            std::error_code ec;
+            std::string key = fs::weakly_canonical(target, ec).string();
+            if (ec) fail(s.loc, fmt::format("cannot open '{}': {}", target.string(), ec.message()));
             if (std::find(import_stack.begin(), import_stack.end(), key) != import_stack.end()) {
                 std::string chain;
                 for (const auto& p : import_stack) chain += fs::path(p).filename().string() + " -> ";

@@ -152,8 +152,9 @@ struct State {
 
     void check_height(uint32_t height, Loc loc) const {
         if (height > max_height)
-            throw CompileError(loc, fmt::format("expression nested deeper than {} levels (split long chains of "
-                                                "operators with `let`)",
+            throw CompileError(loc, fmt::format("expression nested deeper than {} levels: each operator of a chain "
+                                                "is a level (split the chain with `let`, or raise the limit, 4 x "
+                                                "--max-nesting)",
                                                 max_height));
     }
     void push_expr(ExprPtr e, Loc start, uint32_t height) {

@@ -1,7 +1,9 @@
 #include "compiler/base/source.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -121,8 +123,15 @@ const SourceFile& SourceManager::load(const std::string& path, Loc from, size_t 
         if (!sec && size > max_bytes)
             throw CompileError(from, fmt::format("'{}' is {} bytes, over the limit of {} bytes (--max-file-size)", path, size, max_bytes));
     }
+    // The reason, as the OS says it: a missing file, a symlink loop, no permission.
+    if (ec) throw CompileError(from, fmt::format("cannot open '{}': {}", path, ec.message()));
+    errno = 0;
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw CompileError(from, fmt::format("cannot open '{}'", path));
+    if (!in) {
+        const int err = errno;
+        throw CompileError(from, err ? fmt::format("cannot open '{}': {}", path, std::strerror(err))
+                                     : fmt::format("cannot open '{}'", path));
+    }
     // Read up to the limit rather than trust a size: /proc files say 0 and have text.
     std::string text;
     char buf[1 << 16];

@@ -59,4 +59,11 @@ std::string disassemble(const Program& p);
 // Reference evaluation of one point, one instruction at a time (tests, the constant folder's twin).
 std::vector<float> eval_scalar(const Program& p, float x, float y, float z, float time = 0.0f);
 
+// The first output of `p` at n points, into out: how a stage below the runtime samples a
+// field (the raw-field Lipschitz estimate). sample_scalar is the reference; the runtime's
+// sample_batch (runtime/eval/vm.hpp) gives the same values through the batch VM, faster.
+using FieldSampler = void (*)(const Program& p, const float* x, const float* y, const float* z, size_t n, float time,
+                              float* out);
+void sample_scalar(const Program& p, const float* x, const float* y, const float* z, size_t n, float time, float* out);
+
 }  // namespace sdfc

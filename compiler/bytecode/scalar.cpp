@@ -23,4 +23,9 @@ std::vector<float> eval_scalar(const Program& p, float x, float y, float z, floa
     return out;
 }
 
+void sample_scalar(const Program& p, const float* x, const float* y, const float* z, size_t n, float time, float* out) {
+    if (p.outputs.empty()) return;
+    for (size_t i = 0; i < n; ++i) out[i] = eval_scalar(p, x[i], y[i], z[i], time)[0];
+}
+
 }  // namespace sdfc

@@ -62,7 +62,7 @@ struct Parts {
     bool uses_time = false;
 };
 
-Parts generate(const Scene& scene) {
+Parts generate(const Scene& scene, FieldSampler sample) {
     Graph& g = *scene.graph;
     const Loc saved = g.loc();
     g.set_loc(Loc{});  // nodes made outside any shape (the scene's final scaling) name no line
@@ -112,8 +112,8 @@ Parts generate(const Scene& scene) {
     };
     in.camera_position = cam.position[0] == kNoNode ? std::optional<glm::vec3>(glm::vec3(0, 0, 5)) : const_point(cam.position);
     in.camera_target = cam.target[0] == kNoNode ? std::optional<glm::vec3>(glm::vec3(0)) : const_point(cam.target);
-    in.field = [&dist](const float* x, const float* y, const float* z, size_t n, float* out) {
-        for (size_t i = 0; i < n; ++i) out[i] = eval_scalar(dist, x[i], y[i], z[i], 0.0f)[0];
+    in.field = [&dist, sample](const float* x, const float* y, const float* z, size_t n, float* out) {
+        sample(dist, x, y, z, n, 0.0f, out);
     };
     const RenderPlan plan = resolve_plan(in);
     const int nlights = scene.lights.empty() ? 2 : static_cast<int>(scene.lights.size());
@@ -239,9 +239,9 @@ std::string header(const Parts& p, const char* target_line) {
 
 }  // namespace
 
-std::string emit_glsl(const Scene& scene, GlslTarget target) {
+std::string emit_glsl(const Scene& scene, GlslTarget target, FieldSampler sample) {
     if (!scene.graph || !scene.root) throw CompileError(Loc{}, "internal: the scene has no graph");
-    Parts p = generate(scene);
+    Parts p = generate(scene, sample);
     switch (target) {
         case GlslTarget::Shadertoy: {
             std::string s = header(p,

@@ -3,6 +3,7 @@
 #pragma once
 #include <string>
 
+#include "compiler/bytecode/program.hpp"
 #include "compiler/scene/scene.hpp"
 
 namespace sdfc {
@@ -15,6 +16,8 @@ enum class GlslTarget {
 
 // `scene` must be built with a symbolic time (InterpretOptions::time = nullopt) so `time`
 // becomes iTime. Throws CompileError for settings GLSL cannot express.
-std::string emit_glsl(const Scene& scene, GlslTarget target);
+// `sample` evaluates the distance program for the raw-field Lipschitz estimate (the
+// runtime's sample_batch is the fast one; the result is the same).
+std::string emit_glsl(const Scene& scene, GlslTarget target, FieldSampler sample = sample_scalar);
 
 }  // namespace sdfc

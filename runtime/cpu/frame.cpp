@@ -38,12 +38,7 @@ std::vector<Instr> live_code(const Program& p, size_t first) {
 Frame make_frame(const CompiledScene& scene, const RenderOptions& options) {
     // The raw-field Lipschitz estimate samples the distance program through the batch VM.
     auto field = [&scene](const float* x, const float* y, const float* z, size_t n, float* out) {
-        Evaluator ev(scene.distance);
-        for (size_t i = 0; i < n; i += kBatch) {
-            const int m = static_cast<int>(std::min<size_t>(kBatch, n - i));
-            ev.eval(x + i, y + i, z + i, m, scene.time);
-            std::copy_n(ev.output(0), m, out + i);
-        }
+        sample_batch(scene.distance, x, y, z, n, scene.time, out);
     };
     Frame f(scene, plan_for(scene, options.baseline, field));
     f.tile = rules::sdf_tile_size(f.samples);  // ~256+ primary rays, so the lane window stays full

@@ -110,4 +110,14 @@ void BatchVM::eval(const TapeView& t, const float* x, const float* y, const floa
     else run<false>(t.code, end, regs_, x, y, z, n, m, time);
 }
 
+void sample_batch(const Program& p, const float* x, const float* y, const float* z, size_t n, float time, float* out) {
+    if (p.outputs.empty()) return;
+    Evaluator ev(p);
+    for (size_t i = 0; i < n; i += kBatch) {
+        const int m = static_cast<int>(std::min<size_t>(kBatch, n - i));
+        ev.eval(x + i, y + i, z + i, m, time);
+        std::copy_n(ev.output(0), m, out + i);
+    }
+}
+
 }  // namespace sdfc

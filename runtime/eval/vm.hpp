@@ -36,6 +36,9 @@ private:
     float* regs_ = nullptr;
 };
 
+// sample_scalar's values through the batch VM (a FieldSampler, see program.hpp).
+void sample_batch(const Program& p, const float* x, const float* y, const float* z, size_t n, float time, float* out);
+
 // A BatchVM bound to one Program: the older interface (eval without a tape, output(i)).
 class Evaluator : public BatchVM {
 public:

@@ -51,7 +51,7 @@ TEST_CASE("check reports script errors with a caret and exit 1") {
     CHECK(ok.err.empty());
     auto missing = run_sdfc("check /nonexistent/x.sdf");
     CHECK(missing.status == 1);
-    CHECK(missing.err == "sdfc: error: cannot open '/nonexistent/x.sdf'\n");
+    CHECK(missing.err == "sdfc: error: cannot open '/nonexistent/x.sdf': No such file or directory\n");
 }
 
 TEST_CASE("render writes the image, an error leaves no file") {

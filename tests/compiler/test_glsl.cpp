@@ -23,6 +23,7 @@
 #include "compiler/glsl/glsl_emit.hpp"
 #include "compiler/glsl/glsl_renderer.hpp"
 #include "lang/load.hpp"
+#include "runtime/eval/vm.hpp"
 #include "support.hpp"
 
 namespace {
@@ -506,4 +507,18 @@ TEST_CASE("glsl: the shader carries the shared rules as GLSL and the plan's cons
     CHECK(st.find("const bool SDF_PREMARCH = true;") != std::string::npos);
     // No light in the script: the default rig, from the rules.
     CHECK(st.find("sdf_key_light_dir(fwd, right, up)") != std::string::npos);
+}
+
+TEST_CASE("glsl: a raw field's Lipschitz estimate is the same through the batch VM and the scalar reference", "[glsl]") {
+    // A sphere of radius 1 scaled by 3: |grad| = 3, so 1 / (1.5 * 3) = 0.2222.
+    SourceManager sm;
+    const SourceFile& f = sm.add("three.vm", "_x var-x\n_y var-y\n_z var-z\n_a square _x\n_b square _y\n_c square _z\n"
+                                             "_d add _a _b\n_e add _d _c\n_f sqrt _e\n_g const 3\n_h mul _f _g\n_i sub _h _g\n");
+    Scene s = load_vm(sm, f);
+    const std::string fast = emit_glsl(s, GlslTarget::Shadertoy, sample_batch);
+    CHECK(fast == emit_glsl(s, GlslTarget::Shadertoy, sample_scalar));
+    const size_t at = fast.find("const float SDF_RAW_INV_LIPSCHITZ = ");
+    REQUIRE(at != std::string::npos);
+    CHECK(std::stof(fast.substr(at + 36, 12)) == Approx(1.0f / 4.5f).epsilon(0.02));
+    CHECK(fast.find("const bool SDF_RAW = true;") != std::string::npos);
 }

@@ -110,7 +110,7 @@ TEST_CASE("import cycles are errors at the import that closes them") {
 TEST_CASE("missing, directory, FIFO and oversized files are located errors") {
     Folder d;
     d.write("main.sdf", "sphere(1);\nimport \"nothere.sdf\";\n");
-    CHECK(d.first_error("main.sdf") == "DIR/main.sdf:2:1: error: cannot open 'DIR/nothere.sdf'");
+    CHECK(d.first_error("main.sdf") == "DIR/main.sdf:2:1: error: cannot open 'DIR/nothere.sdf': No such file or directory");
     fs::create_directories(d.root / "sub");
     d.write("dir.sdf", "import \"sub\";\n");
     CHECK(d.first_error("dir.sdf") == "DIR/dir.sdf:1:1: error: cannot read 'DIR/sub': not a regular file");
@@ -137,7 +137,16 @@ TEST_CASE("an unreadable file is an error") {
         return;
     }
     d.write("main.sdf", "import \"secret.sdf\";\n");
-    CHECK(d.first_error("main.sdf") == "DIR/main.sdf:1:1: error: cannot open 'DIR/secret.sdf'");
+    CHECK(d.first_error("main.sdf") == "DIR/main.sdf:1:1: error: cannot open 'DIR/secret.sdf': Permission denied");
+}
+
+TEST_CASE("a symlink loop is an error with the OS reason, at the import") {
+    Folder d;
+    fs::create_symlink("b.sdf", d.path("a.sdf"));
+    fs::create_symlink("a.sdf", d.path("b.sdf"));
+    d.write("main.sdf", "sphere(1);\nimport \"a.sdf\";\n");
+    CHECK(d.first_error("main.sdf") == "DIR/main.sdf:2:1: error: cannot open 'DIR/a.sdf': Too many levels of symbolic links");
+    CHECK(d.first_error("a.sdf") == "sdfc: error: cannot open 'DIR/a.sdf': Too many levels of symbolic links");
 }
 
 TEST_CASE("binary files and invalid UTF-8 are errors at the offending byte") {

@@ -160,6 +160,18 @@ TEST_CASE("the nesting limit is a parameter", "[parser]") {
     CHECK_NOTHROW(parse_text(s + ";"));
 }
 
+TEST_CASE("a flat operator chain is bounded by 4 x the nesting limit, and says how to raise it", "[parser]") {
+    std::string s = "x = 1";
+    for (int i = 0; i < 4100; ++i) s += "+1";
+    ParseOptions opts;
+    opts.max_nesting = 1024;  // sdfc's default
+    CHECK(error_of(s + ";", opts) ==
+          "1:5: expression nested deeper than 4096 levels: each operator of a chain is a level (split the chain "
+          "with `let`, or raise the limit, 4 x --max-nesting)");
+    opts.max_nesting = 2000;
+    CHECK_NOTHROW(parse_text(s + ";", opts));
+}
+
 // Runs f() on a new thread with a stack of `bytes` (the caller's stack must not matter).
 template <typename F>
 void on_small_stack(size_t bytes, F f) {
