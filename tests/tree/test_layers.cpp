@@ -37,6 +37,7 @@ const std::vector<Layer>& layers() {
         {"runtime/cpu",
          {"runtime/eval", "runtime/io", "compiler/render", "compiler/bytecode", "compiler/scene", "compiler/ir",
           "compiler/base"}},
+        {"runtime/mesh", {"runtime/eval", "runtime/io", "compiler/bytecode", "compiler/scene", "compiler/ir", "compiler/base"}},
     };
     return table;
 }

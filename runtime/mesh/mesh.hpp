@@ -1,0 +1,52 @@
+// Meshes from a compiled scene: dual contouring on a grid whose empty and full regions the
+// interval evaluator skips (runtime/mesh/dual_contour.cpp), and the files they are written
+// to (runtime/mesh/mesh_file.cpp).
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "compiler/bytecode/compile.hpp"
+
+namespace sdfc::mesh {
+
+struct Mesh {
+    std::vector<glm::vec3> positions;
+    std::vector<glm::vec3> colors;  // per vertex, linear RGB in [0, 1]; empty when not asked for
+    std::vector<std::array<uint32_t, 3>> triangles;  // counter-clockwise seen from outside
+};
+
+struct MeshOptions {
+    // The box meshed. The solid is cut by it, so the mesh is closed even where the surface
+    // leaves the box (an infinite plane gets a lid).
+    glm::vec3 lo{-1.0f}, hi{1.0f};
+    int resolution = 256;  // cells along the longest side of the box
+    size_t max_triangles = 50'000'000;
+    bool colors = false;  // per-vertex colours from the scene's materials
+    float time = 0.0f;
+};
+
+struct MeshStats {
+    glm::ivec3 cells{0};        // the grid, padding included
+    size_t bricks = 0;          // 8^3-cell blocks of the grid
+    size_t active_bricks = 0;   // not proved empty or full by the intervals
+    size_t rescued_bricks = 0;  // proved so, but a neighbour's surface reached them
+    size_t vertices = 0, triangles = 0;
+};
+
+// Cells in the grid for these options (padding included): checked against a limit before
+// the work starts.
+double grid_cells(const MeshOptions& o);
+
+// Throws std::runtime_error when the mesh would have more than max_triangles.
+Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* stats = nullptr);
+
+// The default box: the scene's bounds with a 2% margin (floor planes aside: the box of the
+// rest, which cuts a floor into a thin base), a .vm model's [-1, 1]^3. False when the
+// scene is unbounded otherwise (an infinite repetition, only a plane): --bounds is needed.
+bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi);
+
+}  // namespace sdfc::mesh
