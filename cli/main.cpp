@@ -50,8 +50,9 @@ usage:
   sdfc eval    SCENE (--at X,Y,Z | --points FILE) [--time T]
   sdfc slice   SCENE --axis x|y|z --at V -o OUT [--range UMIN,UMAX,VMIN,VMAX] [--width W] [--height H]
   sdfc mesh    SCENE -o OUT.stl|obj|ply|3mf [--resolution N | --cell SIZE] [--bounds X0,Y0,Z0,X1,Y1,Z1]
-              [--time T] [--threads N] [--max-triangles N] [--max-cells N] [--quiet]
-              dual contouring: closed, sharp-edged; OBJ, PLY and 3MF carry the materials' colours
+              [--time T] [--threads N] [--max-triangles N] [--max-cells N] [--error] [--quiet]
+              dual contouring: closed, sharp-edged; OBJ, PLY and 3MF carry the materials' colours;
+              --error prints |distance| at the vertices, in cells
   sdfc bench   SCENE [--width W] [--height H] [--samples N] [--repeat N] [--threads N] [--baseline]
               prints median_ms, min_ms, evals_per_pixel (SDF evaluations: rays, normals,
               shadows, ao), shading (material evaluations), the mean program length run
@@ -469,6 +470,7 @@ int cmd_mesh(Args& a) {
     auto max_tris = a.value("--max-triangles");
     auto max_cells = a.value("--max-cells");
     bool quiet = a.flag("--quiet") || a.flag("-q");
+    bool error_stats = a.flag("--error");
     std::string path = one_scene(a, "mesh");
     if (!out) throw UsageError("mesh needs -o OUT (.stl, .obj, .ply or .3mf)");
     if (res && cell) throw UsageError("--resolution and --cell are two ways to say the same: give one");
@@ -515,6 +517,21 @@ int cmd_mesh(Args& a) {
     mesh::Mesh m = mesh::mesh_scene(cs, mo, &st);
     double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     mesh::write_mesh(*out, m);
+    if (error_stats && !m.positions.empty()) {
+        // |field| at the vertices, in cells (for an exact distance: how far they are off the surface).
+        std::vector<float> x, y, z, d(m.positions.size());
+        for (const glm::vec3& p : m.positions) x.push_back(p.x), y.push_back(p.y), z.push_back(p.z);
+        sample_batch(cs.distance, x.data(), y.data(), z.data(), x.size(), t, d.data());
+        const float cell_size = longest / float(mo.resolution);
+        double worst = 0.0, sum = 0.0;
+        for (float v : d) worst = std::max(worst, double(std::fabs(v))), sum += std::fabs(v);
+        write_stdout(fmt::format("triangles {} vertices {} ms {:.1f} max_error_cells {:.4g} mean_error_cells {:.4g}\n", m.triangles.size(),
+                                 m.positions.size(), ms, worst / cell_size, sum / double(d.size()) / cell_size));
+    }
+    if (m.triangles.empty())
+        std::fprintf(stderr, "sdfc: warning: the mesh of %s is empty: no surface in the box at %d cells across (a finer "
+                             "--resolution, or other --bounds?)\n",
+                     path.c_str(), mo.resolution);
     if (!quiet)
         std::fprintf(stderr, "sdfc: wrote %s (%zu triangles, %zu vertices, %d cells across, %zu of %zu bricks sampled, %.1f ms)\n",
                      out->c_str(), m.triangles.size(), m.positions.size(), mo.resolution, st.active_bricks + st.rescued_bricks,
