@@ -5,24 +5,29 @@
 
 #include <fmt/format.h>
 
+#include "compiler/base/names.hpp"
+
 namespace sdfc::cli {
 
 bool Args::flag(const std::string& name) {
+    known_.push_back(name);
     bool found = false;
-    for (size_t i = 0; i < args_.size(); ++i)
+    for (size_t i = 0; i < end_; ++i)
         if (!used_[i] && args_[i] == name) used_[i] = found = true;
     return found;
 }
 
 std::optional<std::string> Args::value(const std::string& name, const std::string& alt) {
+    known_.push_back(name);
+    if (!alt.empty()) known_.push_back(alt);
     std::optional<std::string> v;
-    for (size_t i = 0; i < args_.size(); ++i) {
+    for (size_t i = 0; i < end_; ++i) {
         if (used_[i]) continue;
         const std::string& a = args_[i];
         for (const std::string& n : {name, alt}) {
             if (n.empty()) continue;
             if (a == n) {
-                if (i + 1 >= args_.size()) throw UsageError(fmt::format("{} needs a value", n));
+                if (i + 1 >= end_) throw UsageError(fmt::format("{} needs a value", n));
                 used_[i] = used_[i + 1] = true;
                 v = args_[i + 1];
                 ++i;
@@ -42,8 +47,12 @@ std::vector<std::string> Args::positionals() {
     std::vector<std::string> out;
     for (size_t i = 0; i < args_.size(); ++i) {
         if (used_[i]) continue;
-        if (args_[i].size() > 1 && args_[i][0] == '-' && !(args_[i].size() > 1 && (std::isdigit(static_cast<unsigned char>(args_[i][1])) || args_[i][1] == '.')))
-            throw UsageError(fmt::format("unknown option '{}' (see --help)", args_[i]));
+        const std::string& a = args_[i];
+        if (i < end_ && a.size() > 1 && a[0] == '-' && !std::isdigit(static_cast<unsigned char>(a[1])) && a[1] != '.') {
+            const std::string near = nearest_name(a.substr(0, a.find('=')), known_);
+            throw UsageError(near.empty() ? fmt::format("unknown option '{}' (see --help)", a)
+                                          : fmt::format("unknown option '{}' (did you mean `{}`?)", a, near));
+        }
         out.push_back(args_[i]);
     }
     return out;

@@ -14,11 +14,21 @@ struct UsageError : std::runtime_error {
 
 class Args {
 public:
-    Args(std::vector<std::string> a) : args_(std::move(a)), used_(args_.size(), false) {}
+    Args(std::vector<std::string> a) : args_(std::move(a)), used_(args_.size(), false) {
+        end_ = args_.size();
+        for (size_t i = 0; i < args_.size(); ++i)
+            if (args_[i] == "--") {
+                end_ = i;
+                used_[i] = true;
+                break;
+            }
+    }
 
     bool flag(const std::string& name);  // --name (no value)
     std::optional<std::string> value(const std::string& name, const std::string& alt = "");  // --name V or --name=V
-    std::vector<std::string> positionals();  // everything not consumed (call last)
+    // Everything not consumed (call last): an unknown option is an error naming the nearest
+    // option this command asked for; after `--` every argument is a positional.
+    std::vector<std::string> positionals();
 
     static int to_int(const std::string& flag, const std::string& v, long lo, long hi);
     static float to_float(const std::string& flag, const std::string& v);
@@ -27,6 +37,8 @@ public:
 private:
     std::vector<std::string> args_;
     std::vector<bool> used_;
+    std::vector<std::string> known_;  // the options asked for, for did-you-mean
+    size_t end_ = 0;                  // options end here (at `--`, or the end)
 };
 
 }  // namespace sdfc::cli

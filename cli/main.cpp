@@ -1,5 +1,6 @@
 // sdfc: the command line. Each subcommand is a short function over the library stages;
-// every user error ends as `path:line:col: error:` (scripts) or `sdfc: error:` (flags), exit 1.
+// every user error ends as `path:line:col: error:` (scripts, exit 1) or `sdfc: error:` (exit 2 for the
+// command line, 1 for anything else).
 #include <unistd.h>
 
 #include <algorithm>
@@ -582,11 +583,25 @@ int cmd_bench(Args& a) {
     return 0;
 }
 
+// `sdfc CMD --help`: the command's lines of the usage text and the notes after them (the
+// whole text for an unknown command).
+std::string command_usage(const std::string& cmd) {
+    const std::string text = kUsage, head = "  sdfc " + cmd + " ";
+    const size_t at = text.find(head);
+    if (at == std::string::npos || cmd.empty()) return text;
+    size_t end = text.find("\n  sdfc ", at + head.size());
+    const size_t notes = text.find("\n\n", at);
+    if (end == std::string::npos || (notes != std::string::npos && notes < end)) end = notes;
+    std::string out = "usage:\n" + text.substr(at, end - at + 1);
+    if (notes != std::string::npos) out += text.substr(notes + 1);
+    return out;
+}
+
 int dispatch(int argc, char** argv) {
     std::vector<std::string> all(argv + 1, argv + argc);
     if (all.empty() || all[0] == "--help" || all[0] == "-h" || all[0] == "help") {
         std::fputs(kUsage, all.empty() ? stderr : stdout);
-        return all.empty() ? 1 : 0;
+        return all.empty() ? 2 : 0;
     }
     if (all[0] == "--version") {
         std::printf("sdfc %s\n", SDFC_VERSION);
@@ -595,7 +610,7 @@ int dispatch(int argc, char** argv) {
     std::string cmd = all[0];
     Args a(std::vector<std::string>(all.begin() + 1, all.end()));
     if (a.flag("--help") || a.flag("-h")) {
-        std::fputs(kUsage, stdout);
+        write_stdout(command_usage(cmd));
         return 0;
     }
     if (cmd == "render") return cmd_render(a);
@@ -624,9 +639,9 @@ int run(int argc, char** argv) {
         std::string s = e.formatted();
         std::fwrite(s.data(), 1, s.size(), stderr);
         return 1;
-    } catch (const sdfc::cli::UsageError& e) {
+    } catch (const sdfc::cli::UsageError& e) {  // the command line, not the script: exit 2
         std::fprintf(stderr, "sdfc: error: %s\n", e.what());
-        return 1;
+        return 2;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "sdfc: error: %s\n", e.what());
         return 1;

@@ -48,10 +48,10 @@ void check_not_input(const std::string& out, const SourceManager& sm) {
 
 std::string read_bounded(const std::string& path, size_t max_bytes) {
     struct stat st {};
-    if (::stat(path.c_str(), &st) != 0) throw UsageError(fmt::format("cannot read '{}': {}", path, std::strerror(errno)));
-    if (S_ISDIR(st.st_mode)) throw UsageError(fmt::format("cannot read '{}': {}", path, std::strerror(EISDIR)));
+    if (::stat(path.c_str(), &st) != 0) throw std::runtime_error(fmt::format("cannot read '{}': {}", path, std::strerror(errno)));
+    if (S_ISDIR(st.st_mode)) throw std::runtime_error(fmt::format("cannot read '{}': {}", path, std::strerror(EISDIR)));
     FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) throw UsageError(fmt::format("cannot read '{}': {}", path, std::strerror(errno)));
+    if (!f) throw std::runtime_error(fmt::format("cannot read '{}': {}", path, std::strerror(errno)));
     std::string data;
     char buf[1 << 16];
     for (;;) {
@@ -59,14 +59,14 @@ std::string read_bounded(const std::string& path, size_t max_bytes) {
         data.append(buf, n);
         if (data.size() > max_bytes) {
             std::fclose(f);
-            throw UsageError(fmt::format("'{}' is over the limit of {} bytes (raise it with --max-file-size)", path, max_bytes));
+            throw std::runtime_error(fmt::format("'{}' is over the limit of {} bytes (raise it with --max-file-size)", path, max_bytes));
         }
         if (n < sizeof buf) break;
     }
     const bool failed = std::ferror(f);
     const int err = errno;
     std::fclose(f);
-    if (failed) throw UsageError(fmt::format("cannot read '{}': {}", path, std::strerror(err)));
+    if (failed) throw std::runtime_error(fmt::format("cannot read '{}': {}", path, std::strerror(err)));
     return data;
 }
 

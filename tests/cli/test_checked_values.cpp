@@ -27,13 +27,13 @@ TEST_CASE("camera flags get the script's checks") {
     std::string s = test::write_temp("camflags.sdf", "sphere(1);\n");
     const std::string render = "render " + q(s) + " -o " + q(test::temp_dir() + "/camflags.png") + " --width 8 --height 8 ";
     auto r = run_sdfc(render + "--camera-position 0,0,0 --camera-target 0,0,0");
-    CHECK(r.status == 1);
+    CHECK(r.status == 2);
     CHECK(r.err == "sdfc: error: --camera-position/--camera-target: the camera's position and target are the same point\n");
     r = run_sdfc(render + "--camera-position 0,0,1e30");
-    CHECK(r.status == 1);
+    CHECK(r.status == 2);
     CHECK(r.err.find("the camera position is too far from the origin") != std::string::npos);
     r = run_sdfc(render + "--camera-position 0,5,0");  // up (0,1,0) along the view
-    CHECK(r.status == 1);
+    CHECK(r.status == 2);
     CHECK(r.err.find("parallel to the view direction") != std::string::npos);
     r = run_sdfc(render + "--camera-position 0,0,3 --quiet");
     CHECK(r.status == 0);
@@ -96,7 +96,7 @@ TEST_CASE("a thread count above the machine's is capped quietly") {
 TEST_CASE("messages: size limits agree and whole numbers in full and /proc files and a byte-order mark") {
     std::string s = test::write_temp("limits14.sdf", "sphere(1);\n");
     auto r = run_sdfc("render " + q(s) + " -o " + q(test::temp_dir() + "/limits14.png") + " --width 16385");
-    CHECK(r.status == 1);
+    CHECK(r.status == 2);
     CHECK(r.err == "sdfc: error: --width must be from 1 to 16384, not 16385\n");
     auto [st, msg] = check("bigwidth.sdf", "render(width = 2147483647);\nsphere(1);\n");
     CHECK(st == 1);

@@ -20,9 +20,37 @@ TEST_CASE("--help and --version") {
     CHECK(v.out.rfind("sdfc ", 0) == 0);
     auto rh = run_sdfc("render --help");
     CHECK(rh.status == 0);
+    CHECK(rh.out.rfind("usage:\n  sdfc render SCENE...", 0) == 0);  // that command's lines only
+    CHECK(rh.out.find("sdfc glsl") == std::string::npos);
+    CHECK(rh.out.find("Safety limits") != std::string::npos);
+    CHECK(run_sdfc("mesh --help").out.rfind("usage:\n  sdfc mesh    SCENE -o OUT.stl|obj|ply|3mf", 0) == 0);
     auto bad = run_sdfc("rendr x.sdf");
-    CHECK(bad.status == 1);
+    CHECK(bad.status == 2);
     CHECK(bad.err == "sdfc: error: unknown command 'rendr' (did you mean `render`?)\n");
+    auto none = run_sdfc("");
+    CHECK(none.status == 2);
+    CHECK(none.err.find("usage:") != std::string::npos);
+}
+
+TEST_CASE("a bad command line exits 2 and a bad script 1, unknown options get did-you-mean, -- ends options") {
+    const std::string s = test::write_temp("exit_codes.sdf", "sphere(1);\n");
+    auto typo = run_sdfc("render '" + s + "' -o x.png --widht 8");
+    CHECK(typo.status == 2);
+    CHECK(typo.err == "sdfc: error: unknown option '--widht' (did you mean `--width`?)\n");
+    auto far = run_sdfc("check '" + s + "' --zzzzzzzz");
+    CHECK(far.status == 2);
+    CHECK(far.err == "sdfc: error: unknown option '--zzzzzzzz' (see --help)\n");
+    CHECK(run_sdfc("eval '" + s + "' --at 1,2,3,4").status == 2);
+    const std::string bad = test::write_temp("exit_codes_bad.sdf", "sphere(;\n");
+    CHECK(run_sdfc("check '" + bad + "'").status == 1);
+    // After --, a name that starts with '-' is a scene file.
+    CHECK(run_sdfc("check -no-such.sdf").status == 2);
+    auto r = run_sdfc("check -- -no-such.sdf");
+    CHECK(r.status == 1);
+    CHECK(r.err == "sdfc: error: cannot open '-no-such.sdf': No such file or directory\n");
+    auto ok = run_sdfc("eval --at 0,0,0 -- '" + s + "'");
+    CHECK(ok.status == 0);
+    CHECK(ok.out == "-1\n");
 }
 
 TEST_CASE("eval prints one distance per line") {
@@ -37,7 +65,7 @@ TEST_CASE("eval prints one distance per line") {
     std::string neg = test::write_temp("eval_neg.sdf", "field (p) -> -p.x;\n");
     CHECK(run_sdfc("eval '" + neg + "' --at 0,0,0").out == "0\n");  // never "-0"
     auto bad = run_sdfc("eval '" + s + "' --at 1,2");
-    CHECK(bad.status == 1);
+    CHECK(bad.status == 2);
     CHECK(bad.err == "sdfc: error: --at takes 3 comma-separated numbers, not '1,2'\n");
 }
 
@@ -90,7 +118,7 @@ TEST_CASE("render --frames writes one file per frame, and they differ where the 
     CHECK(frames[0].pixels != frames[1].pixels);
     CHECK(frames[1].pixels != frames[2].pixels);
     auto bad = run_sdfc("render '" + s + "' -o '" + test::temp_dir() + "/x.png' --frames 0:3");
-    CHECK(bad.status == 1);
+    CHECK(bad.status == 2);
     CHECK(bad.err == "sdfc: error: rendering several frames needs {frame:04d} in the output name\n");
 }
 
@@ -119,7 +147,7 @@ TEST_CASE("compile --emit lists the AST, the IR and the bytecode") {
     CHECK(bc.out.find("; distance program") != std::string::npos);
     CHECK(bc.out.find("add_i") != std::string::npos);
     auto bad = run_sdfc("compile '" + s + "' --emit tokens");
-    CHECK(bad.status == 1);
+    CHECK(bad.status == 2);
     CHECK(bad.err == "sdfc: error: --emit takes ast, ir or bytecode, not 'tokens'\n");
 }
 

@@ -175,7 +175,7 @@ TEST_CASE("flag --max-pixels (width x height x samples) and --max-frames, no out
     CHECK(first_line(r.err) == s + ":1:1: error: 200x100 pixels at 4 samples is over the limit of 50000 (raise it with --max-pixels)");
     CHECK(!fs::exists(out));
     r = run_sdfc("render '" + s + "' -o '" + out + "' --quiet --width 300 --samples 1 --max-pixels 20000");
-    CHECK(r.status == 1);
+    CHECK(r.status == 2);
     CHECK(first_line(r.err) == "sdfc: error: 300x100 pixels at 1 samples is over the limit of 20000 (raise it with --max-pixels)");
     CHECK(!fs::exists(out));
     r = run_sdfc("render '" + s + "' -o '" + out + "' --quiet --width 20 --height 10 --samples 1 --max-pixels 200");
@@ -184,7 +184,7 @@ TEST_CASE("flag --max-pixels (width x height x samples) and --max-frames, no out
 
     std::string pattern = test::temp_dir() + "/lim_frame_{frame:04d}.png";
     r = run_sdfc("render '" + s + "' -o '" + pattern + "' --quiet --width 8 --height 8 --frames 0:9 --max-frames 5");
-    CHECK(r.status == 1);
+    CHECK(r.status == 2);
     CHECK(first_line(r.err) == "sdfc: error: 10 frames is over the limit of 5 (raise it with --max-frames)");
     CHECK(!fs::exists(test::temp_dir() + "/lim_frame_0000.png"));
     r = run_sdfc("render '" + s + "' -o '" + pattern + "' --quiet --width 8 --height 8 --samples 1 --frames 0:1 --max-frames 2");

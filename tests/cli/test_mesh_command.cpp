@@ -44,7 +44,7 @@ TEST_CASE("mesh writes a binary STL, an OBJ, a PLY and a 3MF of the scene") {
 TEST_CASE("mesh errors come before the work and change nothing") {
     const std::string s = test::write_temp("mesh_sphere.sdf", "sphere(1);\n");
     auto ext = run_sdfc("mesh " + q(s) + " -o " + q(test::temp_dir() + "/x.png"));
-    CHECK(ext.status == 1);
+    CHECK(ext.status == 2);
     CHECK(ext.err == "sdfc: error: cannot write '" + test::temp_dir() + "/x.png': unknown mesh format (use .stl, .obj, .ply or .3mf)\n");
     auto dir = run_sdfc("mesh " + q(s) + " -o /nonexistent-dir/x.stl");
     CHECK(dir.status == 1);

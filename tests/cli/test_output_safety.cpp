@@ -346,7 +346,7 @@ TEST_CASE("eval --points is bounded and a device or directory or missing file or
     CHECK(r.status == 0);
     CHECK(r.out == "-1\n1\n");
     r = run_sdfc("eval " + q(s) + " --at 0,0,0 --points " + q(test::temp_dir() + "/no-such-points"));
-    CHECK(r.status == 1);
+    CHECK(r.status == 2);
     CHECK(r.err == "sdfc: error: eval takes --at X,Y,Z or --points FILE, not both\n");
 }
 
