@@ -24,10 +24,12 @@ inline constexpr int kOpCount = 0
 //           a finite sum that overflows only makes the result unknown needlessly)
 //   Result  NaN when the result has a NaN or infinite end: enough for ops whose formulas
 //           carry a NaN or infinite operand end into the result (add, sub)
-//   B       NaN when operand b has one: min/max carry a's NaN ends (mn(NaN, x) is NaN)
+//   B       NaN when operand b is unknown: min/max carry a's NaN ends (mn(NaN, x) is NaN)
 //           but not b's, and infinities are fine for them
-//   None    ops that carry NaN ends and make no NaN from finite or infinite operands
-//           (plus explicit domain checks: the root of a negative number, ...)
+//   None    ops that carry NaN ends, with explicit checks for the NaN their operands can
+//           make: the root of a negative number, inf - inf, 0 * inf, inf / inf, ... An
+//           infinite end is a value like any other (exp overflows to inf, log(0) is -inf),
+//           so smooth unions of exponentials keep their intervals
 enum class OpPoison { Inputs, Result, B, None };
 
 struct OpInfo {

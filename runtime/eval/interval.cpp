@@ -51,6 +51,18 @@ SDFC_IV_INLINE float mx(float a, float b) { return a < b ? b : a; }
 // turns the result unknown when an operand may be infinite or NaN.
 SDFC_IV_INLINE float poison(float lo, float hi) { return (lo - lo) + (hi - hi); }
 
+// The NaN that infinite operand ends can make (None-poison ops check for their own):
+// [al, ah] + [bl, bh] meets +inf + -inf; [al, ah] * [bl, bh] meets 0 * inf.
+SDFC_IV_INLINE bool infinite_end(float l, float h) { return std::isinf(l) | std::isinf(h); }
+SDFC_IV_INLINE float unknown(float l, float h) { return (std::isnan(l) | std::isnan(h)) ? kNaN : 0.0f; }
+SDFC_IV_INLINE bool opposite_infinities(float al, float ah, float bl, float bh) {
+    return ((ah == kInf) & (bl == -kInf)) | ((al == -kInf) & (bh == kInf));
+}
+SDFC_IV_INLINE bool zero_times_infinity(float al, float ah, float bl, float bh) {
+    const bool a0 = (al <= 0.0f) & (ah >= 0.0f), b0 = (bl <= 0.0f) & (bh >= 0.0f);
+    return (a0 & infinite_end(bl, bh)) | (b0 & infinite_end(al, ah));
+}
+
 // Interval product (corners); no NaN for finite operands.
 SDFC_IV_INLINE void mul_iv(float al, float ah, float bl, float bh, float& lo, float& hi) {
     float p0 = al * bl, p1 = al * bh, p2 = ah * bl, p3 = ah * bh;
@@ -111,7 +123,7 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
         if constexpr (arity >= 3) z += cl + ch;
         z *= 0.0f;
     } else if constexpr (P == Poison::B) {
-        z = (bl + bh) * 0.0f;
+        z = (std::isnan(bl) | std::isnan(bh)) ? kNaN : 0.0f;
     }
     switch (O) {
         case Op::Const: lo = hi = k; return;
@@ -124,11 +136,13 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
         case Op::Abs:
             lo = al >= 0.0f ? al : (ah <= 0.0f ? -ah : 0.0f);
             hi = al >= 0.0f ? ah : (ah <= 0.0f ? -al : mx(-al, ah));
+            z += unknown(al, ah);  // the comparisons above drop NaN ends
             break;
         case Op::Square: {
             float l2 = al * al, h2 = ah * ah;
             lo = al >= 0.0f ? l2 : (ah <= 0.0f ? h2 : 0.0f);
             hi = al >= 0.0f ? h2 : (ah <= 0.0f ? l2 : mx(l2, h2));
+            z += unknown(al, ah);
             break;
         }
         case Op::Sqrt:
@@ -177,14 +191,26 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
             lo = ((al > 0.0f) | (ah < 0.0f)) ? 0.0f : (((al == 0.0f) & (ah == 0.0f)) ? 1.0f : 0.0f);
             hi = ((al > 0.0f) | (ah < 0.0f)) ? 0.0f : 1.0f;
             break;
-        case Op::Add: lo = al + bl; hi = ah + bh; break;
-        case Op::Sub: lo = al - bh; hi = ah - bl; break;
-        case Op::Mul: mul_iv(al, ah, bl, bh, lo, hi); break;
+        case Op::Add:
+            lo = al + bl;
+            hi = ah + bh;
+            z += opposite_infinities(al, ah, bl, bh) ? kNaN : 0.0f;
+            break;
+        case Op::Sub:
+            lo = al - bh;
+            hi = ah - bl;
+            z += opposite_infinities(al, ah, -bh, -bl) ? kNaN : 0.0f;
+            break;
+        case Op::Mul:
+            mul_iv(al, ah, bl, bh, lo, hi);
+            z += zero_times_infinity(al, ah, bl, bh) ? kNaN : 0.0f;
+            break;
         case Op::Div: {
             float q0 = al / bl, q1 = al / bh, q2 = ah / bl, q3 = ah / bh;
             lo = mn(mn(q0, q1), mn(q2, q3));
             hi = mx(mx(q0, q1), mx(q2, q3));
             z += ((bl > 0.0f) | (bh < 0.0f)) ? 0.0f : kNaN;  // the divisor may be zero
+            z += (infinite_end(al, ah) & infinite_end(bl, bh)) ? kNaN : 0.0f;  // inf / inf
             break;
         }
         case Op::Min:
@@ -270,13 +296,24 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
             lo = mx(lo, 0.0f);
             break;
         }
-        case Op::AddI: lo = al + k; hi = ah + k; break;
-        case Op::SubI: lo = k - ah; hi = k - al; break;
+        case Op::AddI:
+            lo = al + k;
+            hi = ah + k;
+            z += opposite_infinities(al, ah, k, k) ? kNaN : 0.0f;
+            z += std::isnan(k) ? kNaN : 0.0f;
+            break;
+        case Op::SubI:
+            lo = k - ah;
+            hi = k - al;
+            z += opposite_infinities(k, k, -ah, -al) ? kNaN : 0.0f;
+            z += std::isnan(k) ? kNaN : 0.0f;
+            break;
         case Op::MulI: {
             float p = al * k, q = ah * k;
             lo = mn(p, q);
             hi = mx(p, q);
-            z += k - k;
+            z += zero_times_infinity(al, ah, k, k) ? kNaN : 0.0f;
+            z += std::isnan(k) ? kNaN : 0.0f;
             break;
         }
         case Op::DivI: {
@@ -284,7 +321,8 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
             lo = mn(p, q);
             hi = mx(p, q);
             z += ((al > 0.0f) | (ah < 0.0f)) ? 0.0f : kNaN;
-            z += k - k;
+            z += (std::isinf(k) & infinite_end(al, ah)) ? kNaN : 0.0f;  // inf / inf
+            z += std::isnan(k) ? kNaN : 0.0f;
             break;
         }
         case Op::MinI:
