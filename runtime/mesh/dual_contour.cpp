@@ -68,6 +68,7 @@ struct Brick {
     uint8_t flipped[kCells] = {};  // ambiguous faces linked the other way (cube.hpp)
     uint32_t vbase[kCells];  // first vertex of each cell, within the brick
     std::vector<glm::vec3> verts;
+    std::vector<glm::ivec3> cell_of;  // each vertex's cell (while placing them)
     std::vector<std::array<uint32_t, 3>> tris;
     uint32_t first_vertex = 0;
 };
@@ -361,6 +362,40 @@ void unpinch(const Grid& g, std::vector<std::unique_ptr<Brick>>& bricks, const s
 
 // ------------------------------------------------------------------ vertices
 
+// Vertices the planes left off the surface (a cell that holds a crease but not the corner
+// its planes meet at, or normals blurred by a nearby crease) are moved onto it: Newton
+// steps along the gradient, kept in the cell. Those within 1/25 of a cell stay (on a curved
+// surface the planes meet a little outside it, which makes up for the flat triangles).
+void settle_vertices(const Grid& g, Brick& b, Scratch& s) {
+    const float h = static_cast<float>(g.h), tol = 0.04f * h, d = std::max(1e-3f * h, 1e-6f);
+    const TapeView tape = b.tape.view();
+    std::vector<uint32_t> todo(b.verts.size());
+    for (uint32_t i = 0; i < todo.size(); ++i) todo[i] = i;
+    for (int step = 0; step < 3 && !todo.empty(); ++step) {
+        s.x.resize(7 * todo.size()), s.y.resize(7 * todo.size()), s.z.resize(7 * todo.size());
+        for (size_t j = 0; j < todo.size(); ++j)
+            for (int k = 0; k < 7; ++k) {
+                glm::vec3 p = b.verts[todo[j]];
+                if (k > 0) p[(k - 1) / 2] += (k & 1) ? d : -d;
+                s.x[7 * j + size_t(k)] = p.x, s.y[7 * j + size_t(k)] = p.y, s.z[7 * j + size_t(k)] = p.z;
+            }
+        s.field(g, tape);
+        size_t kept = 0;
+        for (size_t j = 0; j < todo.size(); ++j) {
+            const float* f = s.f.data() + 7 * j;
+            if (!(std::fabs(f[0]) > tol)) continue;  // on the surface (or NaN: left alone)
+            const glm::vec3 grad = glm::vec3(f[1] - f[2], f[3] - f[4], f[5] - f[6]) / (2.0f * d);
+            const float g2 = glm::dot(grad, grad);
+            if (!(g2 > 1e-12f) || !std::isfinite(g2)) continue;
+            const glm::ivec3 cell = b.cell_of[todo[j]];
+            glm::vec3& v = b.verts[todo[j]];
+            v = glm::clamp(v - grad * (f[0] / g2), g.corner(cell), g.corner(cell + 1));
+            todo[kept++] = todo[j];
+        }
+        todo.resize(kept);
+    }
+}
+
 void place_vertices(const Grid& g, Brick& b, Scratch& s) {
     // Every sign-changing edge of the brick's lattice: slot a * kC3 + lower corner.
     struct Crossing {
@@ -437,6 +472,7 @@ void place_vertices(const Grid& g, Brick& b, Scratch& s) {
         slot_of[size_t(xs[i].slot)] = static_cast<int>(i);
     }
     b.verts.clear();
+    b.cell_of.clear();
     for (int z = 0; z < kB; ++z)
         for (int y = 0; y < kB; ++y)
             for (int x = 0; x < kB; ++x) {
@@ -456,10 +492,11 @@ void place_vertices(const Grid& g, Brick& b, Scratch& s) {
                         const int i = slot_of[size_t(slot)];
                         if (i >= 0) qef.add(at[size_t(i)], normal[size_t(i)]);
                     }
-                    const glm::dvec3 v = qef.solve();
-                    b.verts.push_back(glm::clamp(glm::vec3(v), lo, hi));
+                    b.verts.push_back(glm::clamp(glm::vec3(qef.solve_in(glm::dvec3(lo), glm::dvec3(hi))), lo, hi));
+                    b.cell_of.push_back(cell);
                 }
             }
+    settle_vertices(g, b, s);
 }
 
 // ------------------------------------------------------------------ faces

@@ -91,6 +91,30 @@ TEST_CASE("mesh: a box keeps its corners and edges", "[mesh]") {
     CHECK(on_edge >= 4 * 10);  // about 1 / cell vertices along each of the 4 edges
 }
 
+TEST_CASE("mesh: a rotated box keeps its corners, its vertices on the surface", "[mesh]") {
+    // Cells cut its edges at every angle: vertices the planes leave off the surface are
+    // moved onto it.
+    Meshed b = mesh_text("rotate(x = 30, y = 20, z = 10) box([1, 1, 1]);", 40);
+    check_closed_manifold(b.m);
+    CHECK(euler(b.m) == 2);
+    CHECK(volume(b.m) == Approx(1.0).epsilon(0.005));
+    CHECK(max_vertex_distance(b.m, b.c->cs) <= b.cell / 20.0f);
+    // The 8 corners, sqrt(3)/2 from the centre. A corner whose cell holds crossings of all
+    // three of its faces gets a vertex on it; the others (this box at this grid: 4 of 8)
+    // are cut within their cell, their edges kept.
+    std::vector<glm::vec3> corners;
+    for (const glm::vec3& v : b.m.positions)
+        if (std::fabs(glm::length(v) - 0.8660254f) < b.cell / 20.0f) {
+            bool seen = false;
+            for (const glm::vec3& c : corners) seen |= glm::length(c - v) < 0.5f;
+            if (!seen) corners.push_back(v);
+        }
+    CHECK(corners.size() >= 4);
+    float farthest = 0.0f;
+    for (const glm::vec3& v : b.m.positions) farthest = std::max(farthest, glm::length(v));
+    CHECK(farthest <= 0.8660254f + b.cell / 20.0f);
+}
+
 TEST_CASE("mesh: a difference keeps its inner corners", "[mesh]") {
     // A unit cube with the octant x, y, z > 0 cut away: an inner corner at the origin.
     Meshed d = mesh_text("difference { box([2, 2, 2]); translate([1, 1, 1]) box([2, 2, 2]); }", 31);
@@ -150,7 +174,7 @@ TEST_CASE("mesh: the box cuts the solid and closes it with a lid", "[mesh]") {
 }
 
 TEST_CASE("mesh: no two triangles of small meshes intersect", "[mesh]") {
-    for (const char* src : {"sphere(1);", "box([2, 1.5, 1]);", "difference { box([2, 2, 2]); translate([1, 1, 1]) box([2, 2, 2]); }",
+    for (const char* src : {"sphere(1);", "box([2, 1.5, 1]);", "rotate(x = 30, y = 20, z = 10) box([1, 1, 1]);", "difference { box([2, 2, 2]); translate([1, 1, 1]) box([2, 2, 2]); }",
                             "smooth_union(0.3) { sphere(1); translate([1.2, 0, 0]) sphere(0.8); }", "torus(1, 0.35);"}) {
         INFO(src);
         Meshed m = mesh_text(src, 14);
