@@ -1,7 +1,8 @@
 // One fuzz input through the whole pipeline, as `sdfc` runs it:
 //   source checks -> parse (+ AST listing) -> interpret -> compile_scene -> batch VM at a
 //   few points (both programs; the distance against the one-instruction-at-a-time
-//   reference), then the GLSL emitter on the scene built with a symbolic time.
+//   reference), a coarse mesh (closed and oriented: every directed edge once, its reverse
+//   once), then the GLSL emitter on the scene built with a symbolic time.
 // An input starting with "# vm" is read as a .vm model instead (`#` starts a comment
 // there). The limits are small, so no input can legitimately run long or grow large: a
 // timeout or running out of memory is a finding like a crash, a sanitizer report or a leak.
@@ -22,6 +23,7 @@
 #include "lang/interpreter.hpp"
 #include "lang/load.hpp"
 #include "runtime/eval/vm.hpp"
+#include "runtime/mesh/mesh.hpp"
 
 namespace sdfc::fuzz {
 
@@ -64,6 +66,35 @@ inline std::string evaluate(const CompiledScene& cs) {
     return "";
 }
 
+// "" when a coarse mesh of the scene is closed and consistently oriented.
+inline std::string mesh_check(const CompiledScene& cs) {
+    if (cs.is_2d) return "";
+    mesh::MeshOptions o;
+    if (!mesh::default_box(cs, o.lo, o.hi)) o.lo = glm::vec3(-2.0f), o.hi = glm::vec3(2.0f);
+    const glm::vec3 ext = o.hi - o.lo;
+    if (!(std::max({ext.x, ext.y, ext.z}) < 1e30f)) return "";
+    o.resolution = 6;
+    o.max_triangles = 20000;
+    o.time = cs.time;
+    mesh::Mesh m;
+    try {
+        m = mesh::mesh_scene(cs, o);
+    } catch (const std::runtime_error&) {  // over the triangle limit
+        return "";
+    }
+    std::vector<std::pair<uint32_t, uint32_t>> e, r;
+    for (const auto& t : m.triangles)
+        for (int k = 0; k < 3; ++k) {
+            e.emplace_back(t[size_t(k)], t[size_t((k + 1) % 3)]);
+            r.emplace_back(t[size_t((k + 1) % 3)], t[size_t(k)]);
+        }
+    std::sort(e.begin(), e.end());
+    std::sort(r.begin(), r.end());
+    if (std::adjacent_find(e.begin(), e.end()) != e.end() || e != r)
+        return fmt::format("the mesh is not closed and oriented ({} triangles)", m.triangles.size());
+    return "";
+}
+
 // Runs `text` through the pipeline. A CompileError is the expected outcome of bad input;
 // any other exception propagates. Returns "" or a description of a wrong result.
 inline std::string run(const std::string& text) {
@@ -72,9 +103,15 @@ inline std::string run(const std::string& text) {
         SourceManager sm;
         const SourceFile& f = sm.add(kPath, text);
         check_source_text(f);  // what SourceManager::load checks (NUL bytes, UTF-8)
-        if (vm) return evaluate(compile_scene(load_vm(sm, f)));
+        if (vm) {
+            const CompiledScene cs = compile_scene(load_vm(sm, f));
+            const std::string r = evaluate(cs);
+            return r.empty() ? mesh_check(cs) : r;
+        }
         (void)ast::dump(*ast::parse(f, ast::ParseOptions{options(0.0f).limits.max_nesting}));
-        std::string r = evaluate(compile_scene(interpret_source(sm, f, options(0.5f))));
+        const CompiledScene cs = compile_scene(interpret_source(sm, f, options(0.5f)));
+        std::string r = evaluate(cs);
+        if (r.empty()) r = mesh_check(cs);
         if (!r.empty()) return r;
     } catch (const CompileError& e) {
         (void)e.formatted();
