@@ -514,9 +514,21 @@ int cmd_mesh(Args& a) {
         throw UsageError(fmt::format("a grid of {:.0f} cells is over the limit of {:.0f} (raise it with --max-cells)", cells, cell_limit));
     mo.colors = mesh::mesh_format(*out) != mesh::MeshFormat::Stl;
     auto t0 = std::chrono::steady_clock::now();
+    bool bar = false;  // as render's: on a terminal, for meshes past a second
+    if (!quiet && isatty(fileno(stderr))) {
+        mo.progress = [&](double frac) {
+            const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            if (s < 1.0) return;
+            const int width = 30, fill = std::clamp(int(frac * width), 0, width);
+            std::fprintf(stderr, "\r\033[Ksdfc: %s [%s%s] %3d%%  %.1f s", out->c_str(), std::string(size_t(fill), '#').c_str(),
+                         std::string(size_t(width - fill), '.').c_str(), int(frac * 100.0), s);
+            bar = true;
+        };
+    }
     mesh::MeshStats st;
     mesh::Mesh m = mesh::mesh_scene(cs, mo, &st);
     double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (bar) std::fputs("\r\033[K", stderr);
     mesh::write_mesh(*out, m);
     if (error_stats && !m.positions.empty()) {
         // |field| at the vertices, in cells (for an exact distance: how far they are off the surface).

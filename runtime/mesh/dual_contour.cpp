@@ -22,6 +22,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cfloat>
 #include <cmath>
 #include <memory>
@@ -50,6 +51,10 @@ struct Grid {
     glm::vec3 lo{0.0f}, hi{0.0f};  // the box
     float time = 0.0f;
     bool lipschitz = true;  // a distance bound (not a raw field): intervals may be tightened
+    // Triangles counted as bricks are sampled (two per sign-changing edge a brick owns),
+    // so the limit stops the work before the memory grows.
+    std::atomic<size_t>* triangles = nullptr;
+    size_t max_triangles = 0;
     float coord(int axis, int i) const { return static_cast<float>(origin[axis] + double(i) * h); }
     glm::vec3 corner(glm::ivec3 c) const { return {coord(0, c.x), coord(1, c.y), coord(2, c.z)}; }
     size_t brick_index(glm::ivec3 b) const { return (size_t(b.z) * size_t(bricks.y) + size_t(b.y)) * size_t(bricks.x) + size_t(b.x); }
@@ -212,6 +217,21 @@ std::vector<Sampled> classify(const Grid& g, const Program& p, tbb::enumerable_t
 
 // ------------------------------------------------------------------ sample
 
+// The cells around each sign-changing edge of b (offsets -1 and 0 in the other two axes).
+template <typename F>
+void for_each_crossing(const Brick& b, F&& f) {
+    for (int a = 0; a < 3; ++a) {
+        const glm::ivec3 step(a == 0, a == 1, a == 2);
+        for (int z = 0; z < kC - step.z; ++z)
+            for (int y = 0; y < kC - step.y; ++y)
+                for (int x = 0; x < kC - step.x; ++x) {
+                    const bool in0 = inside(b.value[corner_index(x, y, z)]);
+                    const bool in1 = inside(b.value[corner_index(x + step.x, y + step.y, z + step.z)]);
+                    if (in0 != in1) f(a, glm::ivec3(x, y, z), in0);
+                }
+    }
+}
+
 // Whether the interval [lo, hi] of f over the box proves the meshed field max(f, box)
 // positive (+1) or negative (-1) on all of it; 0 when it does not.
 int proved_sign(const Grid& g, Interval v, const glm::vec3& lo, const glm::vec3& hi) {
@@ -277,22 +297,13 @@ std::unique_ptr<Brick> sample(const Grid& g, Region& r, Scratch& s) {
                     c |= uint8_t(inside(b.value[corner_index(x + (k & 1), y + ((k >> 1) & 1), z + ((k >> 2) & 1))]) << k);
                 b.config[cell_index(x, y, z)] = c;
             }
+    size_t quads = 0;
+    for_each_crossing(b, [&](int, glm::ivec3 c, bool) { quads += c.x < kB && c.y < kB && c.z < kB; });
+    const size_t total = g.triangles->fetch_add(2 * quads) + 2 * quads;
+    if (total > g.max_triangles)
+        throw std::runtime_error(
+            fmt::format("the mesh's triangles are over the limit of {} (raise it with --max-triangles)", g.max_triangles));
     return bp;
-}
-
-// The cells around each sign-changing edge of b (offsets -1 and 0 in the other two axes).
-template <typename F>
-void for_each_crossing(const Brick& b, F&& f) {
-    for (int a = 0; a < 3; ++a) {
-        const glm::ivec3 step(a == 0, a == 1, a == 2);
-        for (int z = 0; z < kC - step.z; ++z)
-            for (int y = 0; y < kC - step.y; ++y)
-                for (int x = 0; x < kC - step.x; ++x) {
-                    const bool in0 = inside(b.value[corner_index(x, y, z)]);
-                    const bool in1 = inside(b.value[corner_index(x + step.x, y + step.y, z + step.z)]);
-                    if (in0 != in1) f(a, glm::ivec3(x, y, z), in0);
-                }
-    }
 }
 
 // Bricks the surface of `b` reaches that are not in the set (marked in `want`).
@@ -568,6 +579,8 @@ bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi) {
 
 Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* stats) {
     Grid g;
+    std::atomic<size_t> triangles{0};
+    g.triangles = &triangles, g.max_triangles = o.max_triangles;
     g.lo = o.lo, g.hi = o.hi, g.time = o.time;
     g.lipschitz = !scene.raw_field;
     const glm::vec3 ext = o.hi - o.lo;
@@ -583,7 +596,11 @@ Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* sta
 
     // map: the brick's index in `bricks`, kUnsampled, or kUniform (sampled: no surface).
     constexpr int32_t kUnsampled = -1, kUniform = -2;
+    auto progress = [&](double f) {
+        if (o.progress) o.progress(f);
+    };
     std::vector<Sampled> got = classify(g, scene.distance, tls);
+    progress(0.5);
     const size_t classified = got.size();
     const size_t nbricks = size_t(g.bricks.x) * size_t(g.bricks.y) * size_t(g.bricks.z);
     std::vector<int32_t> map(nbricks, kUnsampled);
@@ -623,8 +640,10 @@ Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* sta
         got.resize(todo.size());
         tbb::parallel_for(size_t(0), todo.size(), [&](size_t i) { got[i] = {todo[i].at, sample(g, todo[i], tls.local())}; });
     }
+    progress(0.6);
     unpinch(g, bricks, map);
     tbb::parallel_for(size_t(0), bricks.size(), [&](size_t i) { place_vertices(g, *bricks[i], tls.local()); });
+    progress(0.85);
     size_t nverts = 0;
     for (auto& b : bricks) {
         b->first_vertex = static_cast<uint32_t>(nverts);
@@ -635,6 +654,7 @@ Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* sta
         throw std::runtime_error(fmt::format("the mesh would have about {} triangles, over the limit of {} (raise it with --max-triangles)",
                                              2 * nverts, o.max_triangles));
     tbb::parallel_for(size_t(0), bricks.size(), [&](size_t i) { make_faces(g, *bricks[i], map, bricks); });
+    progress(0.95);
     size_t ntris = 0;
     for (auto& b : bricks) ntris += b->tris.size();
     if (ntris > o.max_triangles)

@@ -4,6 +4,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,8 @@ struct MeshOptions {
     size_t max_triangles = 50'000'000;
     bool colors = false;  // per-vertex colours from the scene's materials
     float time = 0.0f;
+    // Called between stages with the fraction of the work done (a progress bar).
+    std::function<void(double)> progress;
 };
 
 struct MeshStats {
