@@ -1,0 +1,34 @@
+// What the commands share: the safety-limit flags, the one-scene argument, building a
+// scene, thread counts and the progress bar line. cli/main.cpp holds most commands,
+// cli/mesh_command.cpp the mesh command.
+#pragma once
+#include <optional>
+#include <string>
+
+#include "cli/args.hpp"
+#include "compiler/base/source.hpp"
+#include "compiler/bytecode/compile.hpp"
+#include "lang/interpreter.hpp"
+
+namespace sdfc::cli {
+
+struct Common {
+    InterpretOptions interp;
+    long max_pixels = 268'435'456;  // width * height * samples
+    int max_frames = 100000;
+};
+
+// The safety-limit flags (--max-*), taken out of the arguments.
+Common read_common(Args& a);
+// The command's one scene file (a usage error for none or several).
+std::string one_scene(Args& a, const char* cmd);
+// Loads and compiles a scene at `time`, its distance checked finite.
+CompiledScene build(SourceManager& sm, const std::string& path, Common& c, std::optional<float> time);
+// --threads, capped at the machine's hardware threads.
+int thread_count(const std::string& v);
+// One progress bar line on standard error, redrawn in place; eta < 0: none.
+void progress_line(const std::string& target, double frac, double elapsed_s, double eta);
+
+int cmd_mesh(Args& a);
+
+}  // namespace sdfc::cli

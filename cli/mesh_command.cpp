@@ -1,0 +1,115 @@
+// `sdfc mesh`: dual contouring (runtime/mesh) of one scene into an STL, OBJ, PLY or 3MF file.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+#include <fmt/format.h>
+#include <tbb/global_control.h>
+
+#include "cli/common.hpp"
+#include "cli/output_checks.hpp"
+#include "runtime/eval/vm.hpp"
+#include "runtime/io/atomic_file.hpp"
+#include "runtime/mesh/mesh_file.hpp"
+
+namespace sdfc::cli {
+
+// Dual contouring (runtime/mesh): the grid, its memory and the output are checked before
+// the work.
+int cmd_mesh(Args& a) {
+    Common c = read_common(a);
+    auto out = a.value("-o", "--output");
+    auto res = a.value("--resolution");
+    auto cell = a.value("--cell");
+    auto bounds = a.value("--bounds");
+    auto time_s = a.value("--time");
+    auto threads = a.value("--threads");
+    auto max_tris = a.value("--max-triangles");
+    auto max_cells = a.value("--max-cells");
+    bool quiet = a.flag("--quiet") || a.flag("-q");
+    bool error_stats = a.flag("--error");
+    std::string path = one_scene(a, "mesh");
+    if (!out) throw UsageError("mesh needs -o OUT (.stl, .obj, .ply or .3mf)");
+    if (res && cell) throw UsageError("--resolution and --cell are two ways to say the same: give one");
+    mesh::MeshOptions mo;
+    if (res) mo.resolution = Args::to_int("--resolution", *res, 1, 16384);
+    if (max_tris) mo.max_triangles = size_t(Args::to_int("--max-triangles", *max_tris, 1, 2000000000));
+    double cell_limit = 1ull << 31;
+    if (max_cells) cell_limit = Args::to_int("--max-cells", *max_cells, 1, 2000000000);
+    if (mesh::mesh_format(*out) == mesh::MeshFormat::Unknown)
+        throw UsageError(fmt::format("cannot write '{}': unknown mesh format (use .stl, .obj, .ply or .3mf)", *out));
+    resolve_output(*out);
+    check_not_input(*out, path);
+    std::unique_ptr<tbb::global_control> limit;
+    if (threads) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, thread_count(*threads));
+    SourceManager sm;
+    const float t = time_s ? Args::to_float("--time", *time_s) : 0.0f;
+    CompiledScene cs = build(sm, path, c, t);
+    check_not_input(*out, sm);
+    if (cs.is_2d) throw std::runtime_error("mesh needs a 3D scene (this one is 2D: render or slice it)");
+    mo.time = t;
+    if (bounds) {
+        auto f = Args::to_floats("--bounds", *bounds, 6);
+        mo.lo = {f[0], f[1], f[2]}, mo.hi = {f[3], f[4], f[5]};
+        if (!(mo.lo.x < mo.hi.x && mo.lo.y < mo.hi.y && mo.lo.z < mo.hi.z))
+            throw UsageError("--bounds needs X0 < X1, Y0 < Y1 and Z0 < Z1");
+    } else if (!mesh::default_box(cs, mo.lo, mo.hi)) {
+        throw UsageError("the scene is unbounded (a plane, an infinite repetition?): give --bounds X0,Y0,Z0,X1,Y1,Z1");
+    }
+    const glm::vec3 ext = mo.hi - mo.lo;
+    const float longest = std::max({ext.x, ext.y, ext.z});
+    if (cell) {
+        const float size = Args::to_float("--cell", *cell);
+        if (!(size > 0.0f)) throw UsageError("--cell must be positive");
+        const double n = std::ceil(double(longest) / size);
+        if (n > 16384) throw UsageError(fmt::format("--cell {} makes {} cells across the box, over 16384", *cell, n));
+        mo.resolution = std::max(1, int(n));
+    }
+    const double cells = mesh::grid_cells(mo);
+    if (cells > cell_limit)
+        throw UsageError(fmt::format("a grid of {:.0f} cells is over the limit of {:.0f} (raise it with --max-cells)", cells, cell_limit));
+    mo.colors = mesh::mesh_format(*out) != mesh::MeshFormat::Stl;
+    auto t0 = std::chrono::steady_clock::now();
+    bool bar = false;  // as render's: on a terminal, for meshes past a second
+    if (!quiet && isatty(fileno(stderr))) {
+        mo.progress = [&](double frac) {
+            const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            if (s < 1.0) return;
+            progress_line(*out, frac, s, -1.0);
+            bar = true;
+        };
+    }
+    mesh::MeshStats st;
+    mesh::Mesh m = mesh::mesh_scene(cs, mo, &st);
+    double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (bar) std::fputs("\r\033[K", stderr);
+    mesh::write_mesh(*out, m);
+    if (error_stats && !m.positions.empty()) {
+        // |field| at the vertices, in cells (for an exact distance: how far they are off the surface).
+        std::vector<float> x, y, z, d(m.positions.size());
+        for (const glm::vec3& p : m.positions) x.push_back(p.x), y.push_back(p.y), z.push_back(p.z);
+        sample_batch(cs.distance, x.data(), y.data(), z.data(), x.size(), t, d.data());
+        const float cell_size = longest / float(mo.resolution);
+        double worst = 0.0, sum = 0.0;
+        for (float v : d) worst = std::max(worst, double(std::fabs(v))), sum += std::fabs(v);
+        write_stdout(fmt::format("triangles {} vertices {} ms {:.1f} max_error_cells {:.4g} mean_error_cells {:.4g}\n", m.triangles.size(),
+                                 m.positions.size(), ms, worst / cell_size, sum / double(d.size()) / cell_size));
+    }
+    if (m.triangles.empty())
+        std::fprintf(stderr, "sdfc: warning: the mesh of %s is empty: no surface in the box at %d cells across (a finer "
+                             "--resolution, or other --bounds?)\n",
+                     path.c_str(), mo.resolution);
+    if (!quiet)
+        std::fprintf(stderr, "sdfc: wrote %s (%zu triangles, %zu vertices, %d cells across, %zu of %zu bricks sampled, %.1f ms)\n",
+                     out->c_str(), m.triangles.size(), m.positions.size(), mo.resolution, st.active_bricks + st.rescued_bricks,
+                     st.bricks, ms);
+    return 0;
+}
+
+}  // namespace sdfc::cli
