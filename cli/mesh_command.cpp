@@ -91,10 +91,12 @@ int cmd_mesh(Args& a) {
     if (bar) std::fputs("\r\033[K", stderr);
     mesh::write_mesh(*out, m);
     if (error_stats && !m.positions.empty()) {
-        // |field| at the vertices, in cells (for an exact distance: how far they are off the surface).
+        // |field| at the vertices, in cells (for an exact distance: how far they are off the
+        // surface), of the field meshed: the scene cut by the box.
         std::vector<float> x, y, z, d(m.positions.size());
         for (const glm::vec3& p : m.positions) x.push_back(p.x), y.push_back(p.y), z.push_back(p.z);
         sample_batch(cs.distance, x.data(), y.data(), z.data(), x.size(), t, d.data());
+        for (size_t i = 0; i < d.size(); ++i) d[i] = std::max(d[i], mesh::box_distance(mo.lo, mo.hi, m.positions[i]));
         const float cell_size = longest / float(mo.resolution);
         double worst = 0.0, sum = 0.0;
         for (float v : d) worst = std::max(worst, double(std::fabs(v))), sum += std::fabs(v);

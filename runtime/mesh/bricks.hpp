@@ -16,6 +16,7 @@
 
 #include "runtime/eval/interval.hpp"
 #include "runtime/eval/vm.hpp"
+#include "runtime/mesh/mesh.hpp"
 
 namespace sdfc::mesh::dc {
 
@@ -40,11 +41,7 @@ struct Grid {
     float coord(int axis, int i) const { return static_cast<float>(origin[axis] + double(i) * h); }
     glm::vec3 corner(glm::ivec3 c) const { return {coord(0, c.x), coord(1, c.y), coord(2, c.z)}; }
     size_t brick_index(glm::ivec3 b) const { return (size_t(b.z) * size_t(bricks.y) + size_t(b.y)) * size_t(bricks.x) + size_t(b.x); }
-    float box(float x, float y, float z) const {
-        const glm::vec3 c = 0.5f * (lo + hi), e = 0.5f * (hi - lo);
-        const glm::vec3 q = glm::abs(glm::vec3(x, y, z) - c) - e;
-        return glm::length(glm::max(q, 0.0f)) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0f);
-    }
+    float box(float x, float y, float z) const { return box_distance(lo, hi, {x, y, z}); }
 };
 
 struct Brick {

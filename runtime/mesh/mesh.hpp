@@ -40,6 +40,13 @@ struct MeshStats {
     size_t vertices = 0, triangles = 0;
 };
 
+// The distance to the box [lo, hi] (negative inside): the mesh is of max(scene, box).
+inline float box_distance(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& p) {
+    const glm::vec3 c = 0.5f * (lo + hi), e = 0.5f * (hi - lo);
+    const glm::vec3 q = glm::abs(p - c) - e;
+    return glm::length(glm::max(q, 0.0f)) + glm::min(glm::max(q.x, glm::max(q.y, q.z)), 0.0f);
+}
+
 // Cells in the grid for these options (padding included): checked against a limit before
 // the work starts.
 double grid_cells(const MeshOptions& o);
