@@ -15,6 +15,7 @@
 #include <glm/glm.hpp>
 
 #include "runtime/eval/interval.hpp"
+#include "runtime/eval/gradient.hpp"
 #include "runtime/eval/vm.hpp"
 #include "runtime/mesh/mesh.hpp"
 
@@ -73,6 +74,26 @@ struct Scratch {
             iv = std::make_unique<IntervalEvaluator>(iv_regs, iv_choices);
         }
         return *iv;
+    }
+    GradientEvaluator grad{64};
+    std::vector<Dual> fg;
+    // The meshed field max(f, box) and its gradient at the points in x, y, z, into fg.
+    void field_gradient(const Grid& g, const TapeView& t) {
+        const size_t n = x.size();
+        fg.resize(n);
+        for (size_t i = 0; i < n; i += kBatch) {
+            const int m = static_cast<int>(std::min<size_t>(kBatch, n - i));
+            grad.eval(t, x.data() + i, y.data() + i, z.data() + i, m, g.time, fg.data() + i);
+            for (int j = 0; j < m; ++j) {
+                const glm::vec3 p(x[i + j], y[i + j], z[i + j]);
+                const float b = g.box(p.x, p.y, p.z);
+                Dual& d = fg[i + j];
+                if (d.v < b) {  // the box's side: its gradient
+                    const glm::vec3 n = box_normal(g.lo, g.hi, p);
+                    d = Dual{b, n.x, n.y, n.z};
+                }
+            }
+        }
     }
     // The meshed field max(f, box) at the points in x, y, z, into f.
     void field(const Grid& g, const TapeView& t) {

@@ -7,8 +7,8 @@
 //   sample    each remaining brick's 9^3 corners through the batch VM with its own tape;
 //             a brick whose surface reaches a skipped neighbour wakes that neighbour (the
 //             proofs are sound, this makes the mesh's closure independent of them)
-//   vertices  every sign-changing edge's crossing (regula falsi) and normal (central
-//             differences); one vertex per patch of a cell (cube.hpp) where its crossings'
+//   vertices  every sign-changing edge's crossing (regula falsi) and normal (the forward-
+//             mode gradient evaluator, runtime/eval/gradient.hpp); one vertex per patch of a cell (cube.hpp) where its crossings'
 //             tangent planes meet (qef.hpp), kept inside the cell
 //   faces     one quad per sign-changing edge, joining the vertices of the four cells
 //             around it, split along the flatter diagonal
@@ -46,29 +46,27 @@ using namespace dc;
 // steps along the gradient, kept in the cell. Those within 1/25 of a cell stay (on a curved
 // surface the planes meet a little outside it, which makes up for the flat triangles).
 void settle_vertices(const Grid& g, Brick& b, Scratch& s) {
-    const float h = static_cast<float>(g.h), tol = 0.04f * h, d = std::max(1e-3f * h, 1e-6f);
+    const float tol = 0.04f * static_cast<float>(g.h);
     const TapeView tape = b.tape.view();
     std::vector<uint32_t> todo(b.verts.size());
     for (uint32_t i = 0; i < todo.size(); ++i) todo[i] = i;
     for (int step = 0; step < 3 && !todo.empty(); ++step) {
-        s.x.resize(7 * todo.size()), s.y.resize(7 * todo.size()), s.z.resize(7 * todo.size());
-        for (size_t j = 0; j < todo.size(); ++j)
-            for (int k = 0; k < 7; ++k) {
-                glm::vec3 p = b.verts[todo[j]];
-                if (k > 0) p[(k - 1) / 2] += (k & 1) ? d : -d;
-                s.x[7 * j + size_t(k)] = p.x, s.y[7 * j + size_t(k)] = p.y, s.z[7 * j + size_t(k)] = p.z;
-            }
-        s.field(g, tape);
+        s.x.resize(todo.size()), s.y.resize(todo.size()), s.z.resize(todo.size());
+        for (size_t j = 0; j < todo.size(); ++j) {
+            const glm::vec3 p = b.verts[todo[j]];
+            s.x[j] = p.x, s.y[j] = p.y, s.z[j] = p.z;
+        }
+        s.field_gradient(g, tape);
         size_t kept = 0;
         for (size_t j = 0; j < todo.size(); ++j) {
-            const float* f = s.f.data() + 7 * j;
-            if (!(std::fabs(f[0]) > tol)) continue;  // on the surface (or NaN: left alone)
-            const glm::vec3 grad = glm::vec3(f[1] - f[2], f[3] - f[4], f[5] - f[6]) / (2.0f * d);
+            const Dual& f = s.fg[j];
+            if (!(std::fabs(f.v) > tol)) continue;  // on the surface (or NaN: left alone)
+            const glm::vec3 grad(f.dx, f.dy, f.dz);
             const float g2 = glm::dot(grad, grad);
             if (!(g2 > 1e-12f) || !std::isfinite(g2)) continue;
             const glm::ivec3 cell = b.cell_of[todo[j]];
             glm::vec3& v = b.verts[todo[j]];
-            v = glm::clamp(v - grad * (f[0] / g2), g.corner(cell), g.corner(cell + 1));
+            v = glm::clamp(v - grad * (f.v / g2), g.corner(cell), g.corner(cell + 1));
             todo[kept++] = todo[j];
         }
         todo.resize(kept);
@@ -122,24 +120,18 @@ void place_vertices(const Grid& g, Brick& b, Scratch& s) {
             }
         }
     }
-    // Crossings and normals (central differences of the meshed field).
-    const float d = std::max(1e-3f * h, 1e-6f);
+    // Crossings and normals (the gradient evaluator's, of the meshed field).
     std::vector<glm::vec3> at(xs.size());
-    s.x.resize(6 * xs.size()), s.y.resize(6 * xs.size()), s.z.resize(6 * xs.size());
+    s.x.resize(xs.size()), s.y.resize(xs.size()), s.z.resize(xs.size());
     for (size_t i = 0; i < xs.size(); ++i) {
         at[i] = point(xs[i], guess(xs[i]));
-        for (int k = 0; k < 6; ++k) {
-            glm::vec3 p = at[i];
-            p[k / 2] += (k & 1) ? -d : d;
-            s.x[6 * i + size_t(k)] = p.x, s.y[6 * i + size_t(k)] = p.y, s.z[6 * i + size_t(k)] = p.z;
-        }
+        s.x[i] = at[i].x, s.y[i] = at[i].y, s.z[i] = at[i].z;
     }
-    s.field(g, tape);
+    s.field_gradient(g, tape);
     std::vector<int> slot_of(3 * kC3, -1);
     std::vector<glm::vec3> normal(xs.size());
     for (size_t i = 0; i < xs.size(); ++i) {
-        const float* f = s.f.data() + 6 * i;
-        glm::vec3 n(f[0] - f[1], f[2] - f[3], f[4] - f[5]);
+        glm::vec3 n(s.fg[i].dx, s.fg[i].dy, s.fg[i].dz);
         const float len = glm::length(n);
         if (std::isfinite(len) && len > 0.0f) {
             n /= len;

@@ -47,6 +47,19 @@ inline float box_distance(const glm::vec3& lo, const glm::vec3& hi, const glm::v
     return glm::length(glm::max(q, 0.0f)) + glm::min(glm::max(q.x, glm::max(q.y, q.z)), 0.0f);
 }
 
+// The gradient of box_distance at p.
+inline glm::vec3 box_normal(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& p) {
+    const glm::vec3 c = 0.5f * (lo + hi), e = 0.5f * (hi - lo), s = glm::sign(p - c);
+    const glm::vec3 q = glm::abs(p - c) - e;
+    const glm::vec3 out = glm::max(q, 0.0f);
+    const float l = glm::length(out);
+    if (l > 0.0f) return s * out / l;
+    const int a = q.x >= q.y && q.x >= q.z ? 0 : (q.y >= q.z ? 1 : 2);
+    glm::vec3 n(0.0f);
+    n[a] = s[a] != 0.0f ? s[a] : 1.0f;
+    return n;
+}
+
 // Cells in the grid for these options (padding included): checked against a limit before
 // the work starts.
 double grid_cells(const MeshOptions& o);
