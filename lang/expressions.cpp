@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "compiler/scene/lower.hpp"
+#include "lang/habits.hpp"
 #include "lang/interp.hpp"
 
 namespace sdfc {
@@ -54,6 +55,7 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                 v.fn = fn;
                 return v;
             }
+            if (std::string hint = habit_hint(e.text); !hint.empty()) fail(e.loc, fmt::format("unknown name '{}'{}", e.text, hint));
             std::vector<std::string> names = builtin_names();
             for (Env* s = env; s; s = s->parent)
                 for (const auto& [n, b] : s->vars) names.push_back(n);

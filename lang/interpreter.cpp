@@ -236,7 +236,10 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
         }
         case ast::StmtKind::Assign: {
             Binding* b = env->find(s.name);
-            if (!b) fail(s.name_loc, fmt::format("unknown variable '{}'", s.name));
+            if (!b)
+                fail(s.name_loc, fmt::format("unknown variable '{0}' (a new name is declared with `let {0} = ...;`, or `var {0} = ...;` "
+                                             "inside a field to change it later)",
+                                             s.name));
             if (!b->mut) fail(s.name_loc, fmt::format("'{}' is a constant (declared with let at line {}); declare it with var to reassign it", s.name, b->loc.line));
             Value v = eval(*s.value, env);
             if (v.t != b->value.t || v.n != b->value.n)

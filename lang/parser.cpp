@@ -34,6 +34,7 @@
 #include "grammar/error_messages.hpp"
 #include "grammar/sdf_grammar.hpp"
 #include "lang/ast.hpp"
+#include "lang/habits.hpp"
 #include "lang/parse_stack.hpp"
 #include "lang/parse_actions.hpp"
 
@@ -191,11 +192,24 @@ CompileError syntax_error(const SourceFile& f, size_t off, std::string msg) {
             }
             std::string hint = lone_amp ? fmt::format(" (did you mean '{0}{0}'?)", static_cast<char>(c))
                                : c == '\'' ? " (strings are written in double quotes)"
+                               : c == '$'  ? " (OpenSCAD's $fn, $fa and $fs have no use here: sdfc's surfaces are exact)"
                                            : "";
             return CompileError(loc_at(f, off), fmt::format("unexpected character {}{}", what, hint));
         }
     }
-    if (msg == g::error_message<g::expect_semi>) return CompileError(loc_at(f, previous_token_end(t, off)), msg);
+    if (msg == g::error_message<g::expect_semi>) {
+        // `function f(x) = ...;`, `float a = 1;`: a statement that starts with another
+        // language's word and a name.
+        // The first word of the error's line (statements start lines, and comments above
+        // them hold any character).
+        size_t start = off;
+        while (start > 0 && t[start - 1] != '\n') --start;
+        while (start < off && (t[start] == ' ' || t[start] == '\t')) ++start;
+        size_t e = start;
+        while (e < t.size() && (std::isalnum(static_cast<unsigned char>(t[e])) || t[e] == '_')) ++e;
+        const std::string hint = e < t.size() && t[e] == ' ' ? habit_hint(t.substr(start, e - start)) : "";
+        return CompileError(loc_at(f, previous_token_end(t, off)), std::string(msg) + hint);
+    }
     if (msg.rfind("expected a ", 0) == 0 && msg.find("name") != std::string::npos && off < t.size()) {
         size_t e = off;
         while (e < t.size() && (std::isalnum(static_cast<unsigned char>(t[e])) || t[e] == '_')) ++e;
