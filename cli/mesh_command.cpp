@@ -40,8 +40,13 @@ int cmd_mesh(Args& a) {
     mesh::MeshOptions mo;
     if (res) mo.resolution = Args::to_int("--resolution", *res, 1, 16384);
     if (max_tris) mo.max_triangles = size_t(Args::to_int("--max-triangles", *max_tris, 1, 2000000000));
-    double cell_limit = 1ull << 31;
-    if (max_cells) cell_limit = Args::to_int("--max-cells", *max_cells, 1, 2000000000);
+    double cell_limit = double(1ull << 31);
+    if (max_cells) {
+        // Up to 2^36 cells (the brick map then takes 512 MB): more than an int holds.
+        cell_limit = std::floor(double(Args::to_float("--max-cells", *max_cells)));
+        if (!(cell_limit >= 1.0 && cell_limit <= double(1ull << 36)))
+            throw UsageError(fmt::format("--max-cells must be from 1 to {}, not {}", 1ull << 36, *max_cells));
+    }
     if (mesh::mesh_format(*out) == mesh::MeshFormat::Unknown)
         throw UsageError(fmt::format("cannot write '{}': unknown mesh format (use .stl, .obj, .ply or .3mf)", *out));
     resolve_output(*out);

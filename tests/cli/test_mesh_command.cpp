@@ -58,6 +58,9 @@ TEST_CASE("mesh errors come before the work and change nothing") {
           "sdfc: error: --bounds needs X0 < X1, Y0 < Y1 and Z0 < Z1\n");
     CHECK(run_sdfc("mesh " + q(s) + " -o a.stl --resolution 4000").err ==
           "sdfc: error: a grid of 64384768512 cells is over the limit of 2147483648 (raise it with --max-cells)\n");
+    CHECK(run_sdfc("mesh " + q(s) + " -o a.stl --max-cells 1e12").err == "sdfc: error: --max-cells must be from 1 to 68719476736, not 1e12\n");
+    auto raised = run_sdfc("mesh " + q(s) + " -o " + q(test::temp_dir() + "/raised.stl") + " --resolution 8 --max-cells 5e9 -q");
+    CHECK(raised.status == 0);  // above the default limit and above what an int holds
     const std::string plane = test::write_temp("mesh_plane.sdf", "plane([0, 1, 0], 0);\n");
     CHECK(run_sdfc("mesh " + q(plane) + " -o a.stl").err ==
           "sdfc: error: the scene is unbounded (a plane, an infinite repetition?): give --bounds X0,Y0,Z0,X1,Y1,Z1\n");
