@@ -132,6 +132,13 @@ Loc loc_at(const SourceFile& f, size_t off) {
 
 // The end of the last token before `off` (which follows that token's whitespace and
 // comments): where a missing ';' belongs.
+// The name (letters, digits, '_') that starts at off; empty if none does.
+std::string_view word_at(std::string_view t, size_t off) {
+    size_t e = off;
+    while (e < t.size() && (std::isalnum(static_cast<unsigned char>(t[e])) || t[e] == '_')) ++e;
+    return t.substr(off, e - off);
+}
+
 size_t previous_token_end(std::string_view t, size_t off) {
     size_t i = 0, last = 0;
     while (i < off && i < t.size()) {
@@ -198,22 +205,19 @@ CompileError syntax_error(const SourceFile& f, size_t off, std::string msg) {
         }
     }
     if (msg == g::error_message<g::expect_semi>) {
-        // `function f(x) = ...;`, `float a = 1;`: a statement that starts with another
-        // language's word and a name.
-        // The first word of the error's line (statements start lines, and comments above
-        // them hold any character).
+        // `function f(x) = ...;`, `float a = 1;`: the error's line starts with another
+        // language's word and a name (statements start lines; a comment above may hold
+        // any character, so the line, not the text since the last ';').
         size_t start = off;
         while (start > 0 && t[start - 1] != '\n') --start;
         while (start < off && (t[start] == ' ' || t[start] == '\t')) ++start;
-        size_t e = start;
-        while (e < t.size() && (std::isalnum(static_cast<unsigned char>(t[e])) || t[e] == '_')) ++e;
-        const std::string hint = e < t.size() && t[e] == ' ' ? habit_hint(t.substr(start, e - start)) : "";
+        const std::string_view first = word_at(t, start);
+        const size_t e = start + first.size();
+        const std::string hint = e < t.size() && t[e] == ' ' ? habit_hint(first) : "";
         return CompileError(loc_at(f, previous_token_end(t, off)), std::string(msg) + hint);
     }
     if (msg.rfind("expected a ", 0) == 0 && msg.find("name") != std::string::npos && off < t.size()) {
-        size_t e = off;
-        while (e < t.size() && (std::isalnum(static_cast<unsigned char>(t[e])) || t[e] == '_')) ++e;
-        std::string_view word = t.substr(off, e - off);
+        const std::string_view word = word_at(t, off);
         if (is_keyword(word)) msg += fmt::format(" ('{}' is a keyword)", word);
     }
     return CompileError(loc_at(f, off), std::move(msg));

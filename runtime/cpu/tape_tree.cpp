@@ -226,12 +226,8 @@ void TreeBuilder::split(TreeScratch& s, uint32_t i) {
         ch.lo = glm::vec3(bx[0][k], bx[2][k], bx[4][k]);
         ch.hi = glm::vec3(bx[1][k], bx[3][k], bx[5][k]);
         const Interval v = iv.result(k);
-        ch.ivlo = v.lo, ch.ivhi = v.hi;
-        if (std::isfinite(dc[k])) {
-            const float r = 0.5f * glm::length(ch.hi - ch.lo) * (1.0f + 1e-5f) + 1e-6f * (1.0f + std::fabs(dc[k]));
-            if (!(ch.ivlo >= dc[k] - r)) ch.ivlo = dc[k] - r;  // also replaces NaN
-            if (!(ch.ivhi <= dc[k] + r)) ch.ivhi = dc[k] + r;
-        }
+        const Interval t = std::isfinite(dc[k]) ? tighten_by_centre(v, dc[k], glm::length(ch.hi - ch.lo)) : v;
+        ch.ivlo = t.lo, ch.ivhi = t.hi;
         ch.depth = c.depth + 1;
         if (settled(ch.ivlo, ch.ivhi) && !(ch.depth < kTreeMaxDepth && c.tape.code.size() > kTreeLeafTape && near_surface(ch))) {
             ch.ref_cell = i;  // will not be split: runs this cell's tape

@@ -7,6 +7,7 @@
 // Unknown: an interval with both ends NaN means "some point may be NaN" (or an operand was
 // infinite); it never decides a choice and propagates through every op (see interval.cpp).
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -24,6 +25,16 @@ struct Interval {
 // The interval semantics of one op (scalar reference; the batch evaluator runs the same
 // code per lane). Inputs (VarX...) and Const return a / [k, k]. `choice` receives the side.
 Interval eval_interval(Op op, Interval a, Interval b, Interval c, float k, uint8_t* choice = nullptr);
+
+// The interval of a 1-Lipschitz bound over a box whose diagonal is `diagonal` long,
+// tightened with the bound's value at the box's centre: it is within half the diagonal of
+// it (the margin covers the floats). Rescues fields whose intervals are weak far away.
+inline Interval tighten_by_centre(Interval v, float centre, float diagonal) {
+    const float r = 0.5f * diagonal * (1.0f + 1e-5f) + 1e-6f * (1.0f + std::fabs(centre));
+    if (!(v.lo >= centre - r)) v.lo = centre - r;  // also replaces NaN
+    if (!(v.hi <= centre + r)) v.hi = centre + r;
+    return v;
+}
 
 inline constexpr int kIvLanes = 64;
 

@@ -15,6 +15,14 @@ namespace sdfc::mesh::dc {
 
 // ------------------------------------------------------------------ classify
 
+// Whether the interval [lo, hi] of f over the box proves the meshed field max(f, box)
+// positive (+1) or negative (-1) on all of it; 0 when it does not.
+static int proved_sign(const Grid& g, Interval v, const glm::vec3& lo, const glm::vec3& hi) {
+    if (glm::any(glm::lessThan(hi, g.lo)) || glm::any(glm::greaterThan(lo, g.hi)) || v.lo > 0.0f) return 1;
+    if (v.hi < 0.0f && glm::all(glm::greaterThan(lo, g.lo)) && glm::all(glm::lessThan(hi, g.hi))) return -1;
+    return 0;
+}
+
 // Every brick the intervals do not prove empty or full, sampled with its simplified tape
 // as soon as the tape is made (only bricks with surface keep theirs).
 std::vector<Sampled> classify(const Grid& g, const Program& p, tbb::enumerable_thread_specific<Scratch>& tls) {
@@ -66,16 +74,9 @@ std::vector<Sampled> classify(const Grid& g, const Program& p, tbb::enumerable_t
             }
             uint64_t lanes = 0;
             for (int k = 0; k < n; ++k) {
-                Interval v = iv.result(k);
                 const glm::vec3 lo(bx[0][k], bx[2][k], bx[4][k]), hi(bx[1][k], bx[3][k], bx[5][k]);
-                if (std::isfinite(centre[k])) {  // a 1-Lipschitz bound is within |p - c| of its centre value
-                    const float rad = 0.5f * glm::length(hi - lo) * (1.0f + 1e-5f) + 1e-6f * (1.0f + std::fabs(centre[k]));
-                    if (!(v.lo >= centre[k] - rad)) v.lo = centre[k] - rad;
-                    if (!(v.hi <= centre[k] + rad)) v.hi = centre[k] + rad;
-                }
-                const bool out_of_box = glm::any(glm::lessThan(hi, g.lo)) || glm::any(glm::greaterThan(lo, g.hi));
-                const bool in_box = glm::all(glm::greaterThan(lo, g.lo)) && glm::all(glm::lessThan(hi, g.hi));
-                if (out_of_box || v.lo > 0.0f || (v.hi < 0.0f && in_box)) continue;
+                const Interval v = iv.result(k);
+                if (proved_sign(g, std::isfinite(centre[k]) ? tighten_by_centre(v, centre[k], glm::length(hi - lo)) : v, lo, hi)) continue;
                 lanes |= uint64_t(1) << k;
             }
             if (!lanes) return;
@@ -102,14 +103,6 @@ std::vector<Sampled> classify(const Grid& g, const Program& p, tbb::enumerable_t
 }
 
 // ------------------------------------------------------------------ sample
-
-// Whether the interval [lo, hi] of f over the box proves the meshed field max(f, box)
-// positive (+1) or negative (-1) on all of it; 0 when it does not.
-static int proved_sign(const Grid& g, Interval v, const glm::vec3& lo, const glm::vec3& hi) {
-    if (glm::any(glm::lessThan(hi, g.lo)) || glm::any(glm::greaterThan(lo, g.hi)) || v.lo > 0.0f) return 1;
-    if (v.hi < 0.0f && glm::all(glm::greaterThan(lo, g.lo)) && glm::all(glm::lessThan(hi, g.hi))) return -1;
-    return 0;
-}
 
 // The brick's corners. Its 64 blocks of 2^3 cells are interval-evaluated first: a block
 // proved outside or inside gives its corners a sign (+-FLT_MAX) without evaluating them;

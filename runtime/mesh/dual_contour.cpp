@@ -28,8 +28,6 @@
 #include <memory>
 #include <stdexcept>
 
-#include <fmt/format.h>
-
 #include "runtime/mesh/bricks.hpp"
 #include "runtime/mesh/cube.hpp"
 #include "runtime/mesh/qef.hpp"
@@ -163,7 +161,7 @@ void place_vertices(const Grid& g, Brick& b, Scratch& s) {
                         const int i = slot_of[size_t(slot)];
                         if (i >= 0) qef.add(at[size_t(i)], normal[size_t(i)]);
                     }
-                    b.verts.push_back(glm::clamp(glm::vec3(qef.solve_in(glm::dvec3(lo), glm::dvec3(hi))), lo, hi));
+                    b.verts.push_back(glm::vec3(qef.solve_in(glm::dvec3(lo), glm::dvec3(hi))));
                     b.cell_of.push_back(cell);
                 }
             }
@@ -213,14 +211,26 @@ void make_faces(const Grid& g, Brick& b, const std::vector<int32_t>& map, const 
     });
 }
 
+// The grid over the box: cubic cells, `resolution` along its longest side, a cell of
+// padding outside it on every side, rounded up to whole bricks.
+Grid grid_for(const MeshOptions& o) {
+    Grid g;
+    g.lo = o.lo, g.hi = o.hi, g.time = o.time;
+    const glm::vec3 ext = o.hi - o.lo;
+    g.h = std::max({ext.x, ext.y, ext.z}) / double(o.resolution);
+    g.origin = glm::dvec3(o.lo) - g.h;
+    for (int a = 0; a < 3; ++a) {
+        g.bricks[a] = static_cast<int>(std::ceil((std::ceil(ext[a] / g.h - 1e-4) + 2.0) / kB));
+        g.cells[a] = g.bricks[a] * kB;
+    }
+    return g;
+}
+
 }  // namespace
 
 double grid_cells(const MeshOptions& o) {
-    const glm::vec3 ext = o.hi - o.lo;
-    const double h = std::max({ext.x, ext.y, ext.z}) / double(o.resolution);
-    double n = 1.0;
-    for (int a = 0; a < 3; ++a) n *= std::ceil((std::ceil(ext[a] / h - 1e-4) + 2.0) / kB) * kB;
-    return n;
+    const Grid g = grid_for(o);
+    return double(g.cells.x) * double(g.cells.y) * double(g.cells.z);
 }
 
 bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi) {
@@ -238,18 +248,10 @@ bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi) {
 }
 
 Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* stats) {
-    Grid g;
+    Grid g = grid_for(o);
     std::atomic<size_t> triangles{0};
     g.triangles = &triangles, g.max_triangles = o.max_triangles;
-    g.lo = o.lo, g.hi = o.hi, g.time = o.time;
     g.lipschitz = !scene.raw_field;
-    const glm::vec3 ext = o.hi - o.lo;
-    g.h = std::max({ext.x, ext.y, ext.z}) / double(o.resolution);
-    g.origin = glm::dvec3(o.lo) - g.h;  // a cell of padding outside the box on every side
-    for (int a = 0; a < 3; ++a) {
-        g.bricks[a] = static_cast<int>(std::ceil((std::ceil(ext[a] / g.h - 1e-4) + 2.0) / kB));
-        g.cells[a] = g.bricks[a] * kB;
-    }
     Mesh m;
     if (scene.distance.outputs.empty()) return m;
     tbb::enumerable_thread_specific<Scratch> tls;
@@ -304,22 +306,18 @@ Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* sta
     unpinch(g, bricks, map);
     tbb::parallel_for(size_t(0), bricks.size(), [&](size_t i) { place_vertices(g, *bricks[i], tls.local()); });
     progress(0.85);
+    // The triangle limit was checked while sampling (the count is exact: two per owned
+    // sign-changing edge); vertex indices must also fit 32 bits.
     size_t nverts = 0;
     for (auto& b : bricks) {
+        if (nverts + b->verts.size() >= 0xFFFFFFFFu) throw std::runtime_error("the mesh would have over 2^32 vertices");
         b->first_vertex = static_cast<uint32_t>(nverts);
         nverts += b->verts.size();
-        if (nverts > 3 * o.max_triangles) break;  // checked below, with the triangles
     }
-    if (nverts >= 0xFFFFFFFFu || nverts / 2 > o.max_triangles)
-        throw std::runtime_error(fmt::format("the mesh would have about {} triangles, over the limit of {} (raise it with --max-triangles)",
-                                             2 * nverts, o.max_triangles));
     tbb::parallel_for(size_t(0), bricks.size(), [&](size_t i) { make_faces(g, *bricks[i], map, bricks); });
     progress(0.95);
     size_t ntris = 0;
     for (auto& b : bricks) ntris += b->tris.size();
-    if (ntris > o.max_triangles)
-        throw std::runtime_error(fmt::format("the mesh would have {} triangles, over the limit of {} (raise it with --max-triangles)",
-                                             ntris, o.max_triangles));
     m.positions.reserve(nverts);
     m.triangles.reserve(ntris);
     for (auto& b : bricks) {

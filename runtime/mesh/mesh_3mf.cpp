@@ -10,7 +10,7 @@
 
 #include <Model/COM/NMR_DLLInterfaces.h>
 
-#include "runtime/io/image.hpp"
+#include "runtime/mesh/mesh_file.hpp"
 
 namespace sdfc::mesh {
 namespace {
@@ -31,11 +31,6 @@ void check(LIB3MFRESULT r, PLib3MFBase* on, const char* what) {
     LPCSTR msg = nullptr;
     if (on) lib3mf_getlasterror(on, &code, &msg);
     throw std::runtime_error(fmt::format("3MF: {} failed ({})", what, msg && *msg ? msg : fmt::format("error {:#x}", unsigned(r))));
-}
-
-BYTE srgb_byte(float linear) {
-    const float v = linear_to_srgb(linear);
-    return static_cast<BYTE>(v <= 0.0f ? 0 : v >= 1.0f ? 255 : int(v * 255.0f + 0.5f));
 }
 
 }  // namespace

@@ -23,10 +23,12 @@ void put(std::string& s, T v) {
     s.append(b, sizeof(T));
 }
 
-// Colours are linear in the scene, sRGB in files (as viewers show them, as the renderer
-// encodes its pictures).
-float srgb(float c) { return linear_to_srgb(std::clamp(c, 0.0f, 1.0f)); }
-uint8_t byte_of(float c) { return static_cast<uint8_t>(std::lround(srgb(c) * 255.0f)); }
+}  // namespace
+
+float srgb_of(float linear) { return linear_to_srgb(std::clamp(linear, 0.0f, 1.0f)); }
+uint8_t srgb_byte(float linear) { return static_cast<uint8_t>(std::lround(srgb_of(linear) * 255.0f)); }
+
+namespace {
 
 std::string stl(const Mesh& m) {
     std::string s;
@@ -54,7 +56,7 @@ std::string obj(const Mesh& m) {
         const glm::vec3& p = m.positions[i];
         if (colors) {
             const glm::vec3& c = m.colors[i];
-            s += fmt::format("v {} {} {} {} {} {}\n", p.x, p.y, p.z, srgb(c.x), srgb(c.y), srgb(c.z));  // the common colour extension
+            s += fmt::format("v {} {} {} {} {} {}\n", p.x, p.y, p.z, srgb_of(c.x), srgb_of(c.y), srgb_of(c.z));  // the common colour extension
         } else {
             s += fmt::format("v {} {} {}\n", p.x, p.y, p.z);
         }
@@ -73,7 +75,7 @@ std::string ply(const Mesh& m) {
     for (size_t i = 0; i < m.positions.size(); ++i) {
         for (int k = 0; k < 3; ++k) put<float>(s, m.positions[i][k]);
         if (colors)
-            for (int k = 0; k < 3; ++k) put<uint8_t>(s, byte_of(m.colors[i][k]));
+            for (int k = 0; k < 3; ++k) put<uint8_t>(s, srgb_byte(m.colors[i][k]));
     }
     for (const auto& t : m.triangles) {
         put<uint8_t>(s, 3);

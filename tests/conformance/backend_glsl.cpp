@@ -94,7 +94,7 @@ std::vector<float> GlslLlvmpipe::eval(const Program&, const std::vector<Point>&,
 
 std::string GlslLlvmpipe::known_difference(const Case& c, const Point& p, float got) {
     if (c.kind != Case::Opcode || c.expect.empty()) return "";
-    const float a = p.x, b = op_info(c.op).has_imm ? c.k : p.y;
+    const float a = p.x;
     const float want = eval_op(c.op, p.x, p.y, p.z, c.k);
     const float err = std::fabs(got - want);
     switch (c.op) {

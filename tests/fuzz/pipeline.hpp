@@ -23,6 +23,7 @@
 #include "lang/interpreter.hpp"
 #include "lang/load.hpp"
 #include "runtime/eval/vm.hpp"
+#include "mesh/mesh_checks.hpp"
 #include "runtime/mesh/mesh.hpp"
 
 namespace sdfc::fuzz {
@@ -82,16 +83,8 @@ inline std::string mesh_check(const CompiledScene& cs) {
     } catch (const std::runtime_error&) {  // over the triangle limit
         return "";
     }
-    std::vector<std::pair<uint32_t, uint32_t>> e, r;
-    for (const auto& t : m.triangles)
-        for (int k = 0; k < 3; ++k) {
-            e.emplace_back(t[size_t(k)], t[size_t((k + 1) % 3)]);
-            r.emplace_back(t[size_t((k + 1) % 3)], t[size_t(k)]);
-        }
-    std::sort(e.begin(), e.end());
-    std::sort(r.begin(), r.end());
-    if (std::adjacent_find(e.begin(), e.end()) != e.end() || e != r)
-        return fmt::format("the mesh is not closed and oriented ({} triangles)", m.triangles.size());
+    if (const size_t bad = test::bad_edges(m))  // the mesh tests' own check
+        return fmt::format("the mesh is not closed and oriented ({} of its edges, {} triangles)", bad, m.triangles.size());
     return "";
 }
 
