@@ -50,9 +50,10 @@ usage:
   sdfc eval    SCENE (--at X,Y,Z | --points FILE) [--time T]
   sdfc slice   SCENE --axis x|y|z --at V -o OUT [--range UMIN,UMAX,VMIN,VMAX] [--width W] [--height H]
   sdfc mesh    SCENE -o OUT.stl|obj|ply|3mf [--resolution N | --cell SIZE] [--bounds X0,Y0,Z0,X1,Y1,Z1]
-              [--time T] [--threads N] [--max-triangles N] [--max-cells N] [--error] [--quiet]
+              [--simplify TOL] [--time T] [--threads N] [--max-triangles N] [--max-cells N] [--error] [--quiet]
               dual contouring: closed, sharp-edged; OBJ, PLY and 3MF carry the materials' colours;
-              --error prints |distance| at the vertices, in cells
+              --simplify: fewer triangles, all within TOL of the surface;
+              --error prints |distance| at the vertices and the triangles' centroids, in cells
   sdfc bench   SCENE [--width W] [--height H] [--samples N] [--repeat N] [--threads N] [--baseline]
               prints median_ms, min_ms, evals_per_pixel (SDF evaluations: rays, normals,
               shadows, ao), shading (material evaluations), the mean program length run

@@ -32,6 +32,7 @@ int cmd_mesh(Args& a) {
     auto threads = a.value("--threads");
     auto max_tris = a.value("--max-triangles");
     auto max_cells = a.value("--max-cells");
+    auto simplify = a.value("--simplify");
     bool quiet = a.flag("--quiet") || a.flag("-q");
     bool error_stats = a.flag("--error");
     std::string path = one_scene(a, "mesh");
@@ -39,6 +40,11 @@ int cmd_mesh(Args& a) {
     if (res && cell) throw UsageError("--resolution and --cell are two ways to say the same: give one");
     mesh::MeshOptions mo;
     if (res) mo.resolution = Args::to_int("--resolution", *res, 1, 16384);
+    if (simplify) {
+        mo.simplify = Args::to_float("--simplify", *simplify);
+        if (!(mo.simplify > 0.0f) || !std::isfinite(mo.simplify))
+            throw UsageError(fmt::format("--simplify takes a distance above 0 (the most the mesh may be off the surface), not {}", *simplify));
+    }
     if (max_tris) mo.max_triangles = size_t(Args::to_int("--max-triangles", *max_tris, 1, 2000000000));
     double cell_limit = double(1ull << 31);
     if (max_cells) {
@@ -76,6 +82,10 @@ int cmd_mesh(Args& a) {
         if (n > 16384) throw UsageError(fmt::format("--cell {} makes {} cells across the box, over 16384", *cell, n));
         mo.resolution = std::max(1, int(n));
     }
+    if (simplify && !quiet && mo.simplify < 0.04f * longest / float(mo.resolution))
+        std::fprintf(stderr, "sdfc: warning: --simplify %s is under 1/25 of a cell (%.3g), the most dual contouring leaves a vertex "
+                             "off the surface: few triangles can go\n",
+                     simplify->c_str(), 0.04 * double(longest) / mo.resolution);
     const double cells = mesh::grid_cells(mo);
     if (cells > cell_limit)
         throw UsageError(fmt::format("a grid of {:.0f} cells is over the limit of {:.0f} (raise it with --max-cells)", cells, cell_limit));
@@ -105,17 +115,30 @@ int cmd_mesh(Args& a) {
         const float cell_size = longest / float(mo.resolution);
         double worst = 0.0, sum = 0.0;
         for (float v : d) worst = std::max(worst, double(std::fabs(v))), sum += std::fabs(v);
-        write_stdout(fmt::format("triangles {} vertices {} ms {:.1f} max_error_cells {:.4g} mean_error_cells {:.4g}\n", m.triangles.size(),
-                                 m.positions.size(), ms, worst / cell_size, sum / double(d.size()) / cell_size));
+        // And at the triangles' centroids: how far the flat triangles are off it.
+        std::vector<float> cx, cy, cz, dc(m.triangles.size());
+        for (const auto& tri : m.triangles) {
+            const glm::vec3 p = (m.positions[tri[0]] + m.positions[tri[1]] + m.positions[tri[2]]) / 3.0f;
+            cx.push_back(p.x), cy.push_back(p.y), cz.push_back(p.z);
+        }
+        sample_batch(cs.distance, cx.data(), cy.data(), cz.data(), cx.size(), t, dc.data());
+        double face_worst = 0.0;
+        for (size_t i = 0; i < dc.size(); ++i)
+            face_worst = std::max(face_worst, double(std::fabs(std::max(dc[i], mesh::box_distance(mo.lo, mo.hi, {cx[i], cy[i], cz[i]})))));
+        write_stdout(fmt::format("triangles {} vertices {} ms {:.1f} max_error_cells {:.4g} mean_error_cells {:.4g} "
+                                 "max_centroid_error_cells {:.4g}\n",
+                                 m.triangles.size(), m.positions.size(), ms, worst / cell_size, sum / double(d.size()) / cell_size,
+                                 face_worst / cell_size));
     }
     if (m.triangles.empty())
         std::fprintf(stderr, "sdfc: warning: the mesh of %s is empty: no surface in the box at %d cells across (a finer "
                              "--resolution, or other --bounds?)\n",
                      path.c_str(), mo.resolution);
     if (!quiet)
-        std::fprintf(stderr, "sdfc: wrote %s (%zu triangles, %zu vertices, %d cells across, %zu of %zu bricks sampled, %.1f ms)\n",
-                     out->c_str(), m.triangles.size(), m.positions.size(), mo.resolution, st.active_bricks + st.rescued_bricks,
-                     st.bricks, ms);
+        std::fprintf(stderr, "sdfc: wrote %s (%zu triangles%s, %zu vertices, %d cells across, %zu of %zu bricks sampled, %.1f ms)\n",
+                     out->c_str(), m.triangles.size(),
+                     simplify ? fmt::format(" simplified from {}", st.unsimplified_triangles).c_str() : "", m.positions.size(),
+                     mo.resolution, st.active_bricks + st.rescued_bricks, st.bricks, ms);
     return 0;
 }
 

@@ -97,9 +97,9 @@ struct Planes {
     void set(int i, const D& d) const { v[i] = d.v, x[i] = d.x, y[i] = d.y, z[i] = d.z; }
 };
 
-// One instruction over n lanes.
-inline void step(const Instr& in, float* base, const float* x, const float* y, const float* z, int n, float time) {
-    constexpr size_t L = size_t(GradientEvaluator::kLanes);
+// One instruction over n lanes; a register's planes are L floats apart (n rounded up to
+// 8: few points keep the registers in few cache lines).
+inline void step(const Instr& in, float* base, size_t L, const float* x, const float* y, const float* z, int n, float time) {
     auto reg = [&](uint16_t r) {
         float* p = base + size_t(r) * 4 * L;
         return Planes{p, p + L, p + 2 * L, p + 3 * L};
@@ -152,9 +152,10 @@ void GradientEvaluator::eval(const TapeView& t, const float* x, const float* y, 
     if (n <= 0) return;
     if (size_t(t.num_regs) * 4 * kLanes > regs_->r.size()) regs_->r.resize(size_t(t.num_regs) * 4 * kLanes);
     float* base = regs_->r.data();
-    for (uint32_t i = 0; i < t.len; ++i) grad::step(t.code[i], base, x, y, z, n, time);
-    const float* r = base + size_t(t.output(0)) * 4 * kLanes;
-    for (int i = 0; i < n; ++i) out[i] = Dual{r[i], r[kLanes + i], r[2 * kLanes + i], r[3 * kLanes + i]};
+    const size_t L = (size_t(n) + 7) & ~size_t(7);
+    for (uint32_t i = 0; i < t.len; ++i) grad::step(t.code[i], base, L, x, y, z, n, time);
+    const float* r = base + size_t(t.output(0)) * 4 * L;
+    for (int i = 0; i < n; ++i) out[i] = Dual{r[i], r[L + i], r[2 * L + i], r[3 * L + i]};
 }
 
 }  // namespace sdfc

@@ -102,6 +102,18 @@ std::vector<Sampled> classify(const Grid& g, const Program& p, tbb::enumerable_t
     return out;
 }
 
+Tape brick_tape(const Grid& g, const Tape& full, glm::ivec3 at, Scratch& s) {
+    float bx[6][kIvLanes];
+    for (int a = 0; a < 3; ++a) bx[2 * a][0] = g.coord(a, at[a] * kB), bx[2 * a + 1][0] = g.coord(a, (at[a] + 1) * kB);
+    IntervalEvaluator& iv = s.interval(full.num_regs, full.choices);
+    iv.eval(full, bx[0], bx[1], bx[2], bx[3], bx[4], bx[5], 1, g.time);
+    simplify_batch(full, iv.choices(), iv.stride(), 1, s.bs, true);
+    Tape t;
+    t.assign(s.bs.code(0), s.bs.len[0], s.bs.out[0], s.bs.regs[0]);
+    t.link();
+    return t;
+}
+
 // ------------------------------------------------------------------ sample
 
 // The brick's corners. Its 64 blocks of 2^3 cells are interval-evaluated first: a block

@@ -144,6 +144,8 @@ struct Sampled {
 std::vector<Sampled> classify(const Grid& g, const Program& p, tbb::enumerable_thread_specific<Scratch>& tls);
 // A brick's corners and cell configurations; null when it has no surface.
 std::unique_ptr<Brick> sample(const Grid& g, Region& r, Scratch& s);
+// The tape simplified for the box of the brick at `at` (the intervals over it, from `full`).
+Tape brick_tape(const Grid& g, const Tape& full, glm::ivec3 at, Scratch& s);
 // Marks in `want` the unsampled bricks (map -1) the surface of b reaches.
 void neighbours_needed(const Grid& g, const Brick& b, const std::vector<int32_t>& map, std::vector<uint8_t>& want);
 // Flips every face pinched on both sides (cube.hpp).

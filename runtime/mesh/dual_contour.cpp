@@ -27,15 +27,19 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "runtime/mesh/bricks.hpp"
 #include "runtime/mesh/cube.hpp"
 #include "runtime/mesh/qef.hpp"
+#include "runtime/mesh/simplify.hpp"
 
 namespace sdfc::mesh {
 namespace {
 
 using namespace dc;
+
+constexpr double kContouringShare = 0.25;  // of the progress bar, when the mesh is simplified after
 
 // ------------------------------------------------------------------ vertices
 
@@ -259,7 +263,7 @@ Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* sta
     // map: the brick's index in `bricks`, kUnsampled, or kUniform (sampled: no surface).
     constexpr int32_t kUnsampled = -1, kUniform = -2;
     auto progress = [&](double f) {
-        if (o.progress) o.progress(f);
+        if (o.progress) o.progress(o.simplify > 0.0f ? kContouringShare * f : f);
     };
     std::vector<Sampled> got = classify(g, scene.distance, tls);
     progress(0.5);
@@ -324,6 +328,55 @@ Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* sta
         m.positions.insert(m.positions.end(), b->verts.begin(), b->verts.end());
         m.triangles.insert(m.triangles.end(), b->tris.begin(), b->tris.end());
     }
+    const size_t made = m.triangles.size();
+    if (o.simplify > 0.0f) {
+        // The field at the simplifier's probes, each with the tape of the brick it falls in
+        // (simplified for that box; made here for bricks sampling skipped), the full tape
+        // outside the grid.
+        std::unordered_map<size_t, Tape> more;  // the tapes of bricks not sampled
+        auto field = [&](const glm::vec3* p, size_t n, Dual* out) {
+            std::vector<std::pair<size_t, uint32_t>> order(n);  // (brick + 1, or 0: outside; point)
+            for (size_t i = 0; i < n; ++i) {
+                const glm::dvec3 c = (glm::dvec3(p[i]) - g.origin) / g.h;
+                const glm::ivec3 b = glm::ivec3(glm::floor(c / double(kB)));
+                const bool in = glm::all(glm::greaterThanEqual(b, glm::ivec3(0))) && glm::all(glm::lessThan(b, g.bricks));
+                order[i] = {in ? g.brick_index(b) + 1 : 0, uint32_t(i)};
+            }
+            std::sort(order.begin(), order.end());
+            std::vector<size_t> start, missing;
+            for (size_t i = 0; i < n; ++i) {
+                if (i > 0 && order[i].first == order[i - 1].first) continue;
+                start.push_back(i);
+                const size_t key = order[i].first;
+                if (key && map[key - 1] < 0 && !more.count(key - 1)) missing.push_back(key - 1);
+            }
+            start.push_back(n);
+            std::vector<Tape> made(missing.size());
+            tbb::parallel_for(size_t(0), missing.size(), [&](size_t k) {
+                const size_t bi = missing[k];
+                const glm::ivec3 at(int(bi % size_t(g.bricks.x)), int(bi / size_t(g.bricks.x) % size_t(g.bricks.y)),
+                                    int(bi / (size_t(g.bricks.x) * size_t(g.bricks.y))));
+                made[k] = brick_tape(g, full, at, tls.local());
+            });
+            for (size_t k = 0; k < missing.size(); ++k) more.emplace(missing[k], std::move(made[k]));
+            tbb::parallel_for(size_t(0), start.size() - 1, [&](size_t k) {
+                Scratch& s = tls.local();
+                const size_t i0 = start[k], i1 = start[k + 1], key = order[i0].first;
+                s.x.clear(), s.y.clear(), s.z.clear();
+                for (size_t i = i0; i < i1; ++i) {
+                    const glm::vec3 q = p[order[i].second];
+                    s.x.push_back(q.x), s.y.push_back(q.y), s.z.push_back(q.z);
+                }
+                const Tape& t = key == 0 ? full : map[key - 1] >= 0 ? bricks[size_t(map[key - 1])]->tape : more.find(key - 1)->second;
+                s.field_gradient(g, t.view());
+                for (size_t i = i0; i < i1; ++i) out[order[i].second] = s.fg[i - i0];
+            });
+        };
+        SimplifyStats ss;
+        simplify_mesh(m, o.simplify, field, &ss, [&](double f) {
+            if (o.progress) o.progress(kContouringShare + (1.0 - kContouringShare) * f);
+        });
+    }
     if (o.colors && scene.shading.outputs.size() >= 1 + kMatChannels) {
         m.colors.resize(m.positions.size());
         tbb::parallel_for(size_t(0), (m.positions.size() + kBatch - 1) / kBatch, [&](size_t blk) {
@@ -346,6 +399,7 @@ Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* sta
         stats->rescued_bricks = sampled - classified;
         stats->vertices = m.positions.size();
         stats->triangles = m.triangles.size();
+        stats->unsimplified_triangles = made;
     }
     return m;
 }

@@ -28,6 +28,8 @@ struct MeshOptions {
     size_t max_triangles = 50'000'000;
     bool colors = false;  // per-vertex colours from the scene's materials
     float time = 0.0f;
+    // Above 0: the mesh is simplified (simplify.hpp), staying this close to the surface.
+    float simplify = 0.0f;
     // Called between stages with the fraction of the work done (a progress bar).
     std::function<void(double)> progress;
 };
@@ -38,6 +40,7 @@ struct MeshStats {
     size_t active_bricks = 0;   // not proved empty or full by the intervals
     size_t rescued_bricks = 0;  // proved so, but a neighbour's surface reached them
     size_t vertices = 0, triangles = 0;
+    size_t unsimplified_triangles = 0;  // as dual contouring made them
 };
 
 // The distance to the box [lo, hi] (negative inside): the mesh is of max(scene, box).

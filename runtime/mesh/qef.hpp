@@ -2,7 +2,8 @@
 // sense, to the tangent planes (p_i, n_i) of a cell's surface crossings. Solved around the
 // crossings' mean with a truncated pseudo-inverse (eigenvalues below a tenth of the largest
 // dropped): on a flat patch the point stays at the mean; on an edge it lies on the crease;
-// at a corner, at the corner; within a box when asked (solve_in).
+// at a corner, at the corner; within a box when asked (solve_in). The simplifier
+// (simplify.cpp) merges vertices' QEFs, made of their triangles' planes, and asks their error.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -14,17 +15,33 @@ namespace sdfc::mesh {
 struct Qef {
     double a[6] = {0, 0, 0, 0, 0, 0};  // A = sum n n^T: xx, xy, xz, yy, yz, zz
     double b[3] = {0, 0, 0};           // sum n (n . p)
-    glm::dvec3 mass{0.0};
-    int count = 0;
+    double c = 0.0;                    // sum (n . p)^2
+    glm::dvec3 mass{0.0};              // sum p
+    double weight = 0.0;               // of the planes: their count, or the triangles' areas
 
-    void add(const glm::vec3& p, const glm::vec3& n) {
+    void add(const glm::vec3& p, const glm::vec3& n, double w = 1.0) {
         const glm::dvec3 dn(n), dp(p);
         const double d = glm::dot(dn, dp);
-        a[0] += dn.x * dn.x, a[1] += dn.x * dn.y, a[2] += dn.x * dn.z;
-        a[3] += dn.y * dn.y, a[4] += dn.y * dn.z, a[5] += dn.z * dn.z;
-        b[0] += dn.x * d, b[1] += dn.y * d, b[2] += dn.z * d;
-        mass += dp;
-        ++count;
+        a[0] += w * dn.x * dn.x, a[1] += w * dn.x * dn.y, a[2] += w * dn.x * dn.z;
+        a[3] += w * dn.y * dn.y, a[4] += w * dn.y * dn.z, a[5] += w * dn.z * dn.z;
+        b[0] += w * dn.x * d, b[1] += w * dn.y * d, b[2] += w * dn.z * d;
+        c += w * d * d;
+        mass += w * dp;
+        weight += w;
+    }
+
+    void merge(const Qef& o) {
+        for (int i = 0; i < 6; ++i) a[i] += o.a[i];
+        for (int i = 0; i < 3; ++i) b[i] += o.b[i];
+        c += o.c, mass += o.mass, weight += o.weight;
+    }
+
+    // The weighted sum of the squared distances from x to the planes.
+    double error(const glm::dvec3& x) const {
+        const double ax = a[0] * x.x + a[1] * x.y + a[2] * x.z;
+        const double ay = a[1] * x.x + a[3] * x.y + a[4] * x.z;
+        const double az = a[2] * x.x + a[4] * x.y + a[5] * x.z;
+        return std::max(0.0, x.x * ax + x.y * ay + x.z * az - 2.0 * (b[0] * x.x + b[1] * x.y + b[2] * x.z) + c);
     }
 
     // The minimiser, or the mean of the crossings where the planes do not pin it down.
@@ -55,7 +72,7 @@ struct Qef {
 private:
     // Minimises with the coordinates marked `fixed` held at `at`.
     glm::dvec3 solve_with(const bool fixed[3], const glm::dvec3& at) const {
-        glm::dvec3 m = count ? mass / double(count) : glm::dvec3(0.0);
+        glm::dvec3 m = weight > 0.0 ? mass / weight : glm::dvec3(0.0);
         for (int i = 0; i < 3; ++i)
             if (fixed[i]) m[i] = at[i];
         const double full[3][3] = {{a[0], a[1], a[2]}, {a[1], a[3], a[4]}, {a[2], a[4], a[5]}};

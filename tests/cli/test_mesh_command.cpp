@@ -77,3 +77,24 @@ TEST_CASE("mesh errors come before the work and change nothing") {
     CHECK(broken.err.find("mesh_bad.sdf:1:8: error:") != std::string::npos);
     CHECK_FALSE(fs::exists(out));
 }
+
+TEST_CASE("mesh --simplify writes fewer triangles, says from how many, and refuses what is not a distance") {
+    const std::string s = test::write_temp("mesh_simplify.sdf", "box([1, 1, 1]);\n");
+    const std::string out = test::temp_dir() + "/simplified.stl";
+    auto r = run_sdfc("mesh " + q(s) + " -o " + q(out) + " --resolution 16 --simplify 0.01");
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    CHECK(r.err.rfind("sdfc: wrote " + out + " (12 triangles simplified from ", 0) == 0);
+    CHECK(test::slurp(out).size() == 84 + 50 * 12);
+    CHECK(run_sdfc("mesh " + q(s) + " -o " + q(out) + " --simplify inf").err == "sdfc: error: --simplify takes a number, not 'inf'\n");
+    for (const char* bad : {"0", "-1"}) {
+        auto e = run_sdfc("mesh " + q(s) + " -o " + q(out) + " --simplify " + bad);
+        CHECK(e.status == 2);
+        CHECK(e.err == std::string("sdfc: error: --simplify takes a distance above 0 (the most the mesh may be off the surface), not ") + bad + "\n");
+    }
+    auto fine = run_sdfc("mesh " + q(s) + " -o " + q(out) + " --resolution 16 --simplify 0.0001");
+    CHECK(fine.status == 0);
+    CHECK(fine.err.rfind("sdfc: warning: --simplify 0.0001 is under 1/25 of a cell (0.0026), the most dual contouring leaves a vertex off the "
+                         "surface: few triangles can go\n", 0) == 0);
+    CHECK(fine.err.find("(12 triangles simplified from") != std::string::npos);  // flat faces go all the same
+}
