@@ -11,14 +11,55 @@
 
 #include <fmt/format.h>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
 
 #include "cli/common.hpp"
 #include "cli/output_checks.hpp"
+#include "runtime/eval/gradient.hpp"
+#include "runtime/eval/tape.hpp"
 #include "runtime/eval/vm.hpp"
 #include "runtime/io/atomic_file.hpp"
 #include "runtime/mesh/mesh_file.hpp"
 
 namespace sdfc::cli {
+namespace {
+
+// How far the points are off the surface meshed (the scene cut by the box): |f| for a
+// distance bound, |f| / |grad f| (to first order) for a raw field, whose values are not
+// distances. NaN counts as infinitely far.
+std::vector<float> surface_distance(const CompiledScene& cs, const mesh::MeshOptions& mo, const std::vector<glm::vec3>& p) {
+    std::vector<float> d(p.size());
+    const Tape full = [&] {
+        Tape t = Tape::from(cs.distance, 0);
+        t.link();
+        return t;
+    }();
+    constexpr size_t B = size_t(kBatch);
+    tbb::parallel_for(size_t(0), (p.size() + B - 1) / B, [&](size_t blk) {
+        thread_local BatchVM vm(64);
+        thread_local GradientEvaluator grad(64);
+        const size_t i0 = blk * B, n = std::min(B, p.size() - i0);
+        float x[kBatch], y[kBatch], z[kBatch];
+        for (size_t j = 0; j < n; ++j) x[j] = p[i0 + j].x, y[j] = p[i0 + j].y, z[j] = p[i0 + j].z;
+        Dual g[kBatch];
+        if (cs.raw_field) {
+            grad.eval(full.view(), x, y, z, int(n), mo.time, g);
+        } else {
+            vm.eval(full.view(), x, y, z, int(n), mo.time);
+            const float* r = vm.output(full.view());
+            for (size_t j = 0; j < n; ++j) g[j] = Dual{r[j], 1.0f, 0.0f, 0.0f};
+        }
+        for (size_t j = 0; j < n; ++j) {
+            const float box = mesh::box_distance(mo.lo, mo.hi, p[i0 + j]);
+            float v = std::fabs(g[j].v), len = std::sqrt(g[j].dx * g[j].dx + g[j].dy * g[j].dy + g[j].dz * g[j].dz);
+            if (!(g[j].v >= box)) v = std::fabs(box), len = 1.0f;  // the box's side (or NaN: below)
+            d[i0 + j] = std::isnan(g[j].v) ? INFINITY : v / (len > 1e-6f ? len : 1.0f);
+        }
+    });
+    return d;
+}
+
+}  // namespace
 
 // Dual contouring (runtime/mesh): the grid, its memory and the output are checked before
 // the work.
@@ -106,29 +147,17 @@ int cmd_mesh(Args& a) {
     if (bar) std::fputs("\r\033[K", stderr);
     mesh::write_mesh(*out, m);
     if (error_stats && !m.positions.empty()) {
-        // |field| at the vertices, in cells (for an exact distance: how far they are off the
-        // surface), of the field meshed: the scene cut by the box.
-        std::vector<float> x, y, z, d(m.positions.size());
-        for (const glm::vec3& p : m.positions) x.push_back(p.x), y.push_back(p.y), z.push_back(p.z);
-        sample_batch(cs.distance, x.data(), y.data(), z.data(), x.size(), t, d.data());
-        for (size_t i = 0; i < d.size(); ++i) d[i] = std::max(d[i], mesh::box_distance(mo.lo, mo.hi, m.positions[i]));
+        std::vector<glm::vec3> centroids;
+        for (const auto& tri : m.triangles) centroids.push_back((m.positions[tri[0]] + m.positions[tri[1]] + m.positions[tri[2]]) / 3.0f);
+        const std::vector<float> dv = surface_distance(cs, mo, m.positions), dc = surface_distance(cs, mo, centroids);
         const float cell_size = longest / float(mo.resolution);
-        double worst = 0.0, sum = 0.0;
-        for (float v : d) worst = std::max(worst, double(std::fabs(v))), sum += std::fabs(v);
-        // And at the triangles' centroids: how far the flat triangles are off it.
-        std::vector<float> cx, cy, cz, dc(m.triangles.size());
-        for (const auto& tri : m.triangles) {
-            const glm::vec3 p = (m.positions[tri[0]] + m.positions[tri[1]] + m.positions[tri[2]]) / 3.0f;
-            cx.push_back(p.x), cy.push_back(p.y), cz.push_back(p.z);
-        }
-        sample_batch(cs.distance, cx.data(), cy.data(), cz.data(), cx.size(), t, dc.data());
-        double face_worst = 0.0;
-        for (size_t i = 0; i < dc.size(); ++i)
-            face_worst = std::max(face_worst, double(std::fabs(std::max(dc[i], mesh::box_distance(mo.lo, mo.hi, {cx[i], cy[i], cz[i]})))));
+        double worst = 0.0, sum = 0.0, face_worst = 0.0;
+        for (float v : dv) worst = std::max(worst, double(v)), sum += v;
+        for (float v : dc) face_worst = std::max(face_worst, double(v));
         write_stdout(fmt::format("triangles {} vertices {} ms {:.1f} max_error_cells {:.4g} mean_error_cells {:.4g} "
-                                 "max_centroid_error_cells {:.4g}\n",
-                                 m.triangles.size(), m.positions.size(), ms, worst / cell_size, sum / double(d.size()) / cell_size,
-                                 face_worst / cell_size));
+                                 "max_centroid_error_cells {:.4g} cell {:.6g}\n",
+                                 m.triangles.size(), m.positions.size(), ms, worst / cell_size, sum / double(dv.size()) / cell_size,
+                                 face_worst / cell_size, cell_size));
     }
     if (m.triangles.empty())
         std::fprintf(stderr, "sdfc: warning: the mesh of %s is empty: no surface in the box at %d cells across (a finer "

@@ -29,7 +29,7 @@ namespace sdfc::mesh {
 namespace {
 
 constexpr uint32_t kGone = ~0u;
-constexpr size_t kRound = 256;  // collapses asked of the field at once
+constexpr size_t kRound = 1024;  // collapses asked of the field at once
 constexpr size_t kGrain = 32;   // of them per task
 constexpr size_t kMaxValence = 40;          // keeps fans, and the checks on them, small
 constexpr size_t kSlot = kMaxValence + 8;    // room for one collapse's probes, or its requeued edges
@@ -172,6 +172,8 @@ private:
     std::vector<uint32_t> version_;  // kGone once collapsed into another
     std::vector<uint32_t> core_lock_, ring_lock_;  // the round whose collapse holds the vertex
     std::vector<uint32_t> ring_;
+    std::vector<glm::vec3> slots_;  // a round's probes
+    std::vector<Queued> requeue_;   // a round's collapses to queue
     std::vector<uint8_t> dead_;      // per triangle
     std::vector<glm::vec3> normal_;  // the surface's at each vertex (the field's, once moved)
     Queue queue_{tol_};
@@ -416,7 +418,11 @@ private:
         if (chosen.empty()) return false;
         ++st.rounds;
         const size_t n = chosen.size();
-        std::vector<glm::vec3> slots(n * kSlot);
+        // Fixed slots per collapse, kept from round to round (only their counts are reset).
+        slots_.resize(std::max(slots_.size(), n * kSlot));
+        requeue_.resize(std::max(requeue_.size(), n * kSlot));
+        std::vector<glm::vec3>& slots = slots_;
+        std::vector<Queued>& requeue = requeue_;
         std::vector<size_t> count(n, 0);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) {
@@ -443,7 +449,6 @@ private:
             ++st.refused_by_field;
             refused_[key(chosen[i].u, chosen[i].v)] = version_[chosen[i].u] + version_[chosen[i].v];
         }
-        std::vector<Queued> requeue(n * kSlot);
         std::vector<size_t> queued_count(n, 0);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) {

@@ -39,12 +39,13 @@ inline std::string write_temp(const std::string& name, const std::string& text) 
     return p;
 }
 
-// Runs `sdfc ARGS` (a shell-quoted string) and captures everything.
-inline RunResult run_sdfc(const std::string& args) {
+// Runs `sdfc ARGS` (a shell-quoted string) and captures everything; `env` ("NAME=value
+// ...") goes before the command.
+inline RunResult run_sdfc(const std::string& args, const std::string& env = "") {
     const char* bin = std::getenv("SDFC_BIN");  // override: test another build of sdfc
     std::string exe = bin ? bin : SDFC_BIN_PATH;
     std::string out = temp_dir() + "/stdout.txt", err = temp_dir() + "/stderr.txt";
-    std::string cmd = "'" + exe + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
+    std::string cmd = env + (env.empty() ? "" : " ") + "'" + exe + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
     int st = std::system(cmd.c_str());
     RunResult r;
     r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;

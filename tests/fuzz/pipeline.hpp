@@ -67,7 +67,8 @@ inline std::string evaluate(const CompiledScene& cs) {
     return "";
 }
 
-// "" when a coarse mesh of the scene is closed and consistently oriented.
+// "" when a coarse mesh of the scene is closed and consistently oriented, and stays so
+// simplified.
 inline std::string mesh_check(const CompiledScene& cs) {
     if (cs.is_2d) return "";
     mesh::MeshOptions o;
@@ -85,6 +86,13 @@ inline std::string mesh_check(const CompiledScene& cs) {
     }
     if (const size_t bad = test::bad_edges(m))  // the mesh tests' own check
         return fmt::format("the mesh is not closed and oriented ({} of its edges, {} triangles)", bad, m.triangles.size());
+    // Simplified (to half a cell), it must stay so, and no vertex may be pinched.
+    o.simplify = 0.5f * std::max({ext.x, ext.y, ext.z}) / float(o.resolution);
+    const mesh::Mesh s = mesh::mesh_scene(cs, o);
+    if (const size_t bad = test::bad_edges(s))
+        return fmt::format("the simplified mesh is not closed and oriented ({} of its edges, {} triangles)", bad, s.triangles.size());
+    if (const size_t pinched = test::pinched_vertices(s))
+        return fmt::format("the simplified mesh has {} pinched vertices", pinched);
     return "";
 }
 

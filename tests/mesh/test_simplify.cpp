@@ -64,7 +64,9 @@ TEST_CASE("simplify: a sphere keeps its shape with a tenth of the triangles", "[
     CHECK(s.st.triangles == s.m.triangles.size());
     CHECK(max_vertex_distance(s.m, s.c->cs) <= s.tol);
     CHECK(max_centroid_distance(s.m, s.c->cs) <= s.tol);
-    CHECK(volume(s.m) == Approx(4.0 / 3.0 * kPi).epsilon(0.01));
+    // Off by at most the tolerance times the area (3 %); the chords lie inside.
+    CHECK(volume(s.m) == Approx(4.0 / 3.0 * kPi).epsilon(0.02));
+    CHECK(volume(s.m) < 4.0 / 3.0 * kPi);
 }
 
 TEST_CASE("simplify: a box becomes its 12 triangles, corners exact", "[mesh]") {

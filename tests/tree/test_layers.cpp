@@ -34,6 +34,7 @@ const std::vector<Layer>& layers() {
         {"compiler/glsl", {"compiler/render", "compiler/bytecode", "compiler/scene", "compiler/ir", "compiler/base"}},
         {"runtime/eval", {"compiler/bytecode", "compiler/scene", "compiler/ir", "compiler/base"}},
         {"runtime/io", {"compiler/render", "compiler/base"}},  // (rules.h's sRGB encoding only)
+        {"runtime/io/oiio", {"runtime/io", "compiler/render", "compiler/base"}},  // the image module
         {"runtime/cpu",
          {"runtime/eval", "runtime/io", "compiler/render", "compiler/bytecode", "compiler/scene", "compiler/ir",
           "compiler/base"}},
@@ -111,6 +112,16 @@ TEST_CASE("includes point down the layers, never up or sideways", "[tree]") {
     for (const std::string& b : bad) UNSCOPED_INFO(b);
     CHECK(bad.empty());
     CHECK(checked > 50);
+}
+
+TEST_CASE("only the image module includes OpenImageIO (start-up without its libraries)", "[tree]") {
+    for (const std::string& rel : source_files()) {
+        if (!is_cxx(rel) || rel.rfind("runtime/io/oiio/", 0) == 0 || rel.rfind("tests/", 0) == 0) continue;
+        for (const std::string& line : lines_of(rel)) {
+            INFO(rel << ": " << line);
+            CHECK(line.find("#include <OpenImageIO/") == std::string::npos);
+        }
+    }
 }
 
 TEST_CASE("no source file is over 700 lines", "[tree]") {

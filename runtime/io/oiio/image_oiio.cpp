@@ -1,0 +1,310 @@
+// The image files, through OpenImageIO: a module of its own (libsdfc_image.so), opened by
+// runtime/io/image.cpp at the first image read or write, so that the commands that write
+// none do not load the ~250 libraries Debian's OpenImageIO links.
+#include "runtime/io/image.hpp"
+#include "runtime/io/image_backend.hpp"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <filesystem>
+#include <stdexcept>
+#include <system_error>
+
+#include "compiler/render/rules.h"
+#include "runtime/io/atomic_file.hpp"
+
+namespace sdfc {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lower_ext(const std::string& path) {
+    std::string e = fs::path(path).extension().string();
+    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return e;
+}
+
+bool is_float_format(const std::string& ext) { return ext == ".exr" || ext == ".hdr" || ext == ".pfm"; }
+
+uint8_t to_u8(float display) {
+    if (!(display > 0.0f)) return 0;
+    if (display >= 1.0f) return 255;
+    return static_cast<uint8_t>(display * 255.0f + 0.5f);
+}
+
+float finite_or_zero(float v) { return std::isfinite(v) ? v : 0.0f; }
+
+// Formats that are no image file: OpenImageIO's "null" writes nothing, "term" draws on a terminal.
+bool is_file_format(const char* name) { return std::strcmp(name, "null") != 0 && std::strcmp(name, "term") != 0; }
+
+std::unique_ptr<OIIO::ImageOutput> image_output_for(const std::string& path, OIIO::Filesystem::IOProxy* proxy = nullptr) {
+    const std::string ext = fs::path(path).extension().string();
+    if (ext.empty() || ext == ".")
+        throw std::runtime_error(write_error(path, "no extension to choose the image format from (.png, .jpg, .exr, .hdr, .tif, ...)"));
+    auto out = OIIO::ImageOutput::create(path, proxy);
+    (void)OIIO::geterror();  // clear: the message names nothing useful
+    if (!out || !is_file_format(out->format_name()))
+        throw std::runtime_error(write_error(path, "unknown image format '" + ext + "' (known: .png, .jpg, .exr, .hdr, .tif, .bmp, .tga, ...)"));
+    return out;
+}
+
+// A full decode of what was encoded: a truncated, empty or broken encoding is found here,
+// not in a file later. decodes_in_memory: false also where no reader takes the bytes from
+// memory; verify_file throws "cannot write 'PATH': ..." (`file` named as PATH).
+bool decodes(OIIO::ImageInput* in, int width, int height, int nch, std::string* err) {
+    if (!in) return false;
+    const OIIO::ImageSpec& spec = in->spec();
+    std::vector<float> px(size_t(std::max(spec.width, 0)) * std::max(spec.height, 0) * std::max(spec.nchannels, 1));
+    bool ok = spec.width == width && spec.height == height && spec.nchannels >= std::min(nch, 3) &&
+              in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data());
+    if (!ok && err) *err = in->geterror();
+    in->close();
+    return ok;
+}
+
+bool decodes_in_memory(const std::string& path, const std::vector<unsigned char>& mem, int width, int height, int nch) {
+    OIIO::Filesystem::IOMemReader reader(mem.data(), mem.size());
+    // OpenImageIO opens a file of the name it is given even with a proxy (a FIFO there
+    // would block): a name that cannot exist, with the extension that picks the reader.
+    const std::string none = "/dev/null/encoded" + fs::path(path).extension().string();
+    auto probe = OIIO::ImageInput::create(none, false, nullptr, &reader);
+    bool ok = probe && probe->supports("ioproxy");
+    probe.reset();
+    if (ok) {
+        auto in = OIIO::ImageInput::open(none, nullptr, &reader);
+        ok = decodes(in.get(), width, height, nch, nullptr);
+    }
+    (void)OIIO::geterror();
+    return ok;
+}
+
+void verify_file(const std::string& path, const std::string& file, int width, int height, int nch) {
+    auto in = OIIO::ImageInput::open(file);
+    std::string err = in ? std::string() : OIIO::geterror();
+    if (!decodes(in.get(), width, height, nch, &err))
+        throw std::runtime_error(write_error(path, "the encoded image does not read back" + (err.empty() ? "" : " (" + err + ")"), file));
+}
+
+// Encodes `data` (width*height*names.size() values of `type`) in the format `path`'s
+// extension names, checks it decodes, and writes it with write_file (checked, atomic).
+// In memory where the format's writer takes an IOProxy; otherwise through a temporary
+// file in the system's temporary folder, read back.
+void write_atomic(const std::string& path, int width, int height, const std::vector<std::string>& names,
+                  OIIO::TypeDesc type, const void* data, bool linear) {
+    if (width <= 0 || height <= 0) throw std::runtime_error(write_error(path, "the image is empty"));
+    OIIO::ImageSpec spec(width, height, static_cast<int>(names.size()), type);
+    spec.channelnames = names;
+    spec.alpha_channel = -1;
+    for (size_t i = 0; i < names.size(); ++i)
+        if (names[i] == "Z") spec.z_channel = static_cast<int>(i);
+    spec.attribute("oiio:ColorSpace", linear ? "Linear" : "sRGB");
+    spec.attribute("Software", "sdfc");
+    auto encode = [&](OIIO::ImageOutput& out, const std::string& name, const std::string& temp) {
+        bool ok = out.open(name, spec) && out.write_image(type, data);
+        std::string err = ok ? std::string() : out.geterror();
+        if (!out.close() && ok) ok = false, err = out.geterror();
+        if (!ok) throw std::runtime_error(write_error(path, err.empty() ? OIIO::geterror() : err, temp));
+    };
+    std::vector<unsigned char> buf;
+    bool encoded = false;
+    if (image_output_for(path)->supports("ioproxy")) {
+        OIIO::Filesystem::IOVecOutput vec(buf);
+        auto out = image_output_for(path, &vec);
+        encode(*out, path, "");
+        out.reset();
+        encoded = decodes_in_memory(path, buf, width, height, int(names.size()));
+    }
+    if (!encoded) {
+        // No writer or no reader in memory, or a broken encoding there (this OpenImageIO's
+        // TIFF writer through a proxy): encoded to a file and decoded from it.
+        const fs::path tmp_dir = fs::temp_directory_path();
+        TempFile tmp(temp_path_for((tmp_dir / fs::path(path).filename()).string()));
+        auto out = image_output_for(tmp.path());
+        encode(*out, tmp.path(), tmp.path());
+        out.reset();
+        verify_file(path, tmp.path(), width, height, int(names.size()));
+        std::ifstream in(tmp.path(), std::ios::binary);
+        buf.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        if (in.bad() || buf.empty()) throw std::runtime_error(write_error(path, "cannot read back the encoded image"));
+    }
+    write_file(path, std::string_view(reinterpret_cast<const char*>(buf.data()), buf.size()));
+}
+
+void write_side_file(const std::string& path, const Image& img, const AovPlane& a) {
+    const size_t n = static_cast<size_t>(img.width) * img.height;
+    if (a.data.size() < n * a.channels) throw std::runtime_error("cannot write '" + path + "': AOV '" + a.name + "' has the wrong size");
+    std::vector<uint8_t> px;
+    std::vector<std::string> names;
+    if (a.name == "normal" && a.channels == 3) {
+        // Normal map convention: n * 0.5 + 0.5, stored as data (no sRGB); misses black.
+        names = {"R", "G", "B"};
+        px.resize(n * 3);
+        for (size_t i = 0; i < n; ++i) {
+            const float* v = &a.data[i * 3];
+            bool miss = v[0] == 0.0f && v[1] == 0.0f && v[2] == 0.0f;
+            for (int c = 0; c < 3; ++c) px[i * 3 + c] = miss ? 0 : to_u8(finite_or_zero(v[c]) * 0.5f + 0.5f);
+        }
+    } else if (a.name == "steps" && a.channels == 1) {
+        // Heat map normalised by the largest count in the image.
+        names = {"R", "G", "B"};
+        px.resize(n * 3);
+        float mx = 0.0f;
+        for (size_t i = 0; i < n; ++i) mx = std::max(mx, finite_or_zero(a.data[i]));
+        for (size_t i = 0; i < n; ++i) {
+            float rgb[3];
+            heat_color(mx > 0 ? finite_or_zero(a.data[i]) / mx : 0.0f, rgb);
+            for (int c = 0; c < 3; ++c) px[i * 3 + c] = to_u8(rgb[c]);
+        }
+    } else {
+        // Depth (and any other single plane): normalised to the plane's range, near = white.
+        names = {"Y"};
+        px.resize(n);
+        float lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; i < n; ++i) {
+            float v = a.data[i * a.channels];
+            if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+        }
+        for (size_t i = 0; i < n; ++i) {
+            float v = a.data[i * a.channels];
+            float t = (std::isfinite(v) && hi > lo) ? 1.0f - (v - lo) / (hi - lo) : 0.0f;
+            px[i] = to_u8(t);
+        }
+    }
+    write_atomic(aov_side_path(path, a.name), img.width, img.height, names, OIIO::TypeDesc::UINT8, px.data(), true);
+}
+
+void oiio_check_image_output(const std::string& path) {
+    resolve_output(path);
+    (void)image_output_for(path);
+}
+
+void oiio_write_image(const std::string& path, const Image& img, const WriteOptions& opt) {
+    oiio_check_image_output(path);  // before any side file: a bad main path changes nothing
+    const std::string ext = lower_ext(path);
+    const size_t n = static_cast<size_t>(std::max(img.width, 0)) * std::max(img.height, 0);
+    const int nc = std::clamp(img.channels, 1, 4);
+    if (img.pixels.size() < n * img.channels) throw std::runtime_error("cannot write '" + path + "': pixel buffer has the wrong size");
+    static const char* kRGBA[] = {"R", "G", "B", "A"};
+
+    if (ext == ".exr") {
+        // Linear float, AOVs as extra channels.
+        std::vector<std::string> names(kRGBA, kRGBA + nc);
+        if (nc == 1) names = {"Y"};
+        std::vector<const AovPlane*> planes;
+        for (const auto& a : img.aovs) {
+            if (a.data.size() < n * a.channels) throw std::runtime_error("cannot write '" + path + "': AOV '" + a.name + "' has the wrong size");
+            planes.push_back(&a);
+            if (a.name == "depth" && a.channels == 1) names.push_back("Z");
+            else if (a.name == "normal" && a.channels == 3) names.insert(names.end(), {"N.x", "N.y", "N.z"});
+            else if (a.channels == 1) names.push_back(a.name);
+            else
+                for (int c = 0; c < a.channels; ++c) names.push_back(a.name + "." + "xyzw"[c % 4]);
+        }
+        const size_t total = names.size();
+        std::vector<float> buf(n * total);
+        for (size_t i = 0; i < n; ++i) {
+            float* o = &buf[i * total];
+            for (int c = 0; c < nc; ++c) o[c] = finite_or_zero(img.pixels[i * img.channels + c]);
+            size_t k = nc;
+            for (const AovPlane* a : planes)
+                for (int c = 0; c < a->channels; ++c) o[k++] = finite_or_zero(a->data[i * a->channels + c]);
+        }
+        write_atomic(path, img.width, img.height, names, OIIO::TypeDesc::FLOAT, buf.data(), true);
+        return;
+    }
+
+    // Other formats: AOVs go to side files (written first: the main image appearing last
+    // means the whole set is complete).
+    if (opt.aov_side_files)
+        for (const auto& a : img.aovs) write_side_file(path, img, a);
+
+    const int oc = nc == 2 ? 1 : nc;  // no grey+alpha
+    std::vector<std::string> names(kRGBA, kRGBA + oc);
+    if (oc == 1) names = {"Y"};
+    if (is_float_format(ext)) {
+        const int fc = ext == ".hdr" ? 3 : oc;  // RGBE is always RGB
+        std::vector<std::string> fnames(kRGBA, kRGBA + fc);
+        std::vector<float> buf(n * fc);
+        for (size_t i = 0; i < n; ++i)
+            for (int c = 0; c < fc; ++c) {
+                float v = finite_or_zero(img.pixels[i * img.channels + std::min(c, oc - 1)]);
+                buf[i * fc + c] = ext == ".hdr" ? std::max(v, 0.0f) : v;
+            }
+        write_atomic(path, img.width, img.height, fnames, OIIO::TypeDesc::FLOAT, buf.data(), true);
+        return;
+    }
+    // 8-bit, sRGB-encoded colour; alpha stays linear.
+    std::vector<uint8_t> buf(n * oc);
+    for (size_t i = 0; i < n; ++i)
+        for (int c = 0; c < oc; ++c) {
+            float v = img.pixels[i * img.channels + c];
+            buf[i * oc + c] = to_u8(c == 3 ? v : linear_to_srgb(v));
+        }
+    write_atomic(path, img.width, img.height, names, OIIO::TypeDesc::UINT8, buf.data(), false);
+}
+
+Image oiio_read_image(const std::string& path) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) {
+        std::string e = OIIO::geterror();
+        throw std::runtime_error("cannot read '" + path + "': " + (e.empty() ? std::string("unknown error") : e));
+    }
+    const OIIO::ImageSpec spec = in->spec();
+    const int w = spec.width, h = spec.height, nch = spec.nchannels;
+    std::vector<float> buf(static_cast<size_t>(w) * h * nch);
+    if (!in->read_image(0, 0, 0, nch, OIIO::TypeDesc::FLOAT, buf.data())) {
+        std::string e = in->geterror();
+        throw std::runtime_error("cannot read '" + path + "': " + e);
+    }
+    in->close();
+    const bool is_float = spec.format.basetype == OIIO::TypeDesc::FLOAT || spec.format.basetype == OIIO::TypeDesc::HALF ||
+                          spec.format.basetype == OIIO::TypeDesc::DOUBLE;
+
+    std::vector<int> colour;
+    int z = -1, steps = -1, nrm[3] = {-1, -1, -1};
+    for (int c = 0; c < nch; ++c) {
+        const std::string nm = c < static_cast<int>(spec.channelnames.size()) ? spec.channelnames[c] : std::string();
+        if (nm == "Z") z = c;
+        else if (nm == "steps") steps = c;
+        else if (nm == "N.x") nrm[0] = c;
+        else if (nm == "N.y") nrm[1] = c;
+        else if (nm == "N.z") nrm[2] = c;
+        else colour.push_back(c);
+    }
+    const size_t n = static_cast<size_t>(w) * h;
+    Image img(w, h, std::max<int>(1, static_cast<int>(colour.size())));
+    for (size_t i = 0; i < n; ++i)
+        for (size_t k = 0; k < colour.size(); ++k) {
+            float v = buf[i * nch + colour[k]];
+            const std::string& nm = spec.channelnames[colour[k]];
+            img.pixels[i * img.channels + k] = (is_float || nm == "A") ? v : srgb_to_linear(v);
+        }
+    auto plane = [&](const char* name, std::initializer_list<int> chans) {
+        AovPlane a{name, static_cast<int>(chans.size()), std::vector<float>(n * chans.size())};
+        for (size_t i = 0; i < n; ++i) {
+            int k = 0;
+            for (int c : chans) a.data[i * a.channels + k++] = buf[i * nch + c];
+        }
+        img.aovs.push_back(std::move(a));
+    };
+    if (z >= 0) plane("depth", {z});
+    if (nrm[0] >= 0 && nrm[1] >= 0 && nrm[2] >= 0) plane("normal", {nrm[0], nrm[1], nrm[2]});
+    if (steps >= 0) plane("steps", {steps});
+    return img;
+}
+
+const ImageBackend kBackend{kImageBackendVersion, oiio_write_image, oiio_check_image_output, oiio_read_image};
+
+}  // namespace
+}  // namespace sdfc
+
+extern "C" __attribute__((visibility("default"))) const sdfc::ImageBackend* sdfc_image_backend() { return &sdfc::kBackend; }
