@@ -111,7 +111,7 @@ int cmd_mesh(Args& a) {
         mo.lo = {f[0], f[1], f[2]}, mo.hi = {f[3], f[4], f[5]};
         if (!(mo.lo.x < mo.hi.x && mo.lo.y < mo.hi.y && mo.lo.z < mo.hi.z))
             throw UsageError("--bounds needs X0 < X1, Y0 < Y1 and Z0 < Z1");
-    } else if (!mesh::default_box(cs, mo.lo, mo.hi)) {
+    } else if (!mesh::default_box(cs, mo.lo, mo.hi, t)) {
         throw UsageError("the scene is unbounded (a plane, an infinite repetition?): give --bounds X0,Y0,Z0,X1,Y1,Z1");
     }
     const glm::vec3 ext = mo.hi - mo.lo;

@@ -22,6 +22,31 @@ LoweredScene lower_scene(Graph& g, const Scene& scene) {
 
 namespace {
 
+// A plane at the top of the scene (through material modifiers): a floor.
+bool is_floor(const Shape& s) {
+    if (s.kind == ShapeKind::Material) return s.children.size() == 1 && is_floor(*s.children[0]);
+    return s.kind == ShapeKind::Plane;
+}
+
+// The rest of a scene with floors, when its bounds are unknown (a custom field): its
+// distance, for the mesher to find them with the intervals. kNoNode when not needed.
+NodeId solid_without_floors(Graph& g, const Scene& scene, const SceneBounds& sb) {
+    if (scene.raw_field || sb.bounds.finite() || sb.solid_bounds.finite() || scene.root->kind != ShapeKind::Union) return kNoNode;
+    Vec3N p{g.input(Op::VarX), g.input(Op::VarY), g.input(Op::VarZ)};
+    NodeId d = kNoNode;
+    bool floors = false;
+    for (const auto& c : scene.root->children) {
+        if (is_floor(*c)) {
+            floors = true;
+            continue;
+        }
+        const Lowered l = lower_shape(g, *c, p, nullptr);
+        const NodeId di = l.lip == 1.0f ? l.d : g.mulc(l.d, 1.0f / l.lip);
+        d = d == kNoNode ? di : g.min(d, di);
+    }
+    return floors ? d : kNoNode;
+}
+
 float constant(const Graph& g, NodeId n, Loc loc, const char* what) {
     if (n == kNoNode) throw CompileError(loc, fmt::format("internal: {} is unset", what));
     if (!g.is_const(n)) throw CompileError(loc, fmt::format("{} must be a constant here", what));
@@ -121,6 +146,10 @@ CompiledScene compile_scene(const Scene& scene) {
     cs.background = constant3(g, scene.background, c.loc, "the background color");
     cs.render = scene.render;
     SceneBounds sb = scene_bounds(scene);
+    if (const NodeId solid = solid_without_floors(g, scene, sb); solid != kNoNode) {
+        cs.solid = codegen(g, {solid}, {"d"});
+        check_constants(cs.solid);
+    }
     cs.bounds = sb.bounds;
     cs.solid_bounds = sb.solid_bounds;
     cs.half_spaces = std::move(sb.half_spaces);

@@ -50,6 +50,10 @@ struct CompiledScene {
     // n.p <= w (unit n). Empty otherwise.
     Bounds solid_bounds;
     std::vector<glm::vec4> half_spaces;
+    // The scene without its floor planes, when they make the bounds infinite and the rest's
+    // bounds are unknown (a custom field): the mesher finds its box by the intervals.
+    // Empty (no outputs) otherwise.
+    Program solid;
     bool is_2d = false;
     bool raw_field = false;
     float time = 0.0f;

@@ -237,20 +237,6 @@ double grid_cells(const MeshOptions& o) {
     return double(g.cells.x) * double(g.cells.y) * double(g.cells.z);
 }
 
-bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi) {
-    if (scene.raw_field) {
-        lo = glm::vec3(-1.0f), hi = glm::vec3(1.0f);
-        return true;
-    }
-    // Floor planes make the bounds infinite: the box around the rest (solid_bounds).
-    const Bounds& b = scene.bounds.finite() ? scene.bounds : scene.solid_bounds;
-    if (!b.finite() || !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) return false;
-    const glm::vec3 ext = b.hi - b.lo;
-    const float m = 0.02f * std::max({ext.x, ext.y, ext.z, 1e-3f});
-    lo = b.lo - m, hi = b.hi + m;
-    return true;
-}
-
 Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* stats) {
     Grid g = grid_for(o);
     std::atomic<size_t> triangles{0};

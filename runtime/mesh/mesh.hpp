@@ -71,8 +71,16 @@ double grid_cells(const MeshOptions& o);
 Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* stats = nullptr);
 
 // The default box: the scene's bounds with a 2% margin (floor planes aside: the box of the
-// rest, which cuts a floor into a thin base), a .vm model's [-1, 1]^3. False when the
-// scene is unbounded otherwise (an infinite repetition, only a plane): --bounds is needed.
-bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi);
+// rest, which cuts a floor into a thin base), a .vm model's [-1, 1]^3. Where the scene's
+// shapes give no bounds (a custom field), the intervals find them (auto_box.cpp). False
+// when the scene is unbounded (an infinite repetition, only a plane): --bounds is needed.
+bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float time = 0.0f);
+
+// A box holding every point the interval evaluator does not prove outside, searched within
+// [-kSearch, kSearch]^3 to about 1/32 of the solid's size; false if that reaches the search
+// cube's faces (no bounded solid) or finds nothing. A distance bound (lipschitz) is also
+// bounded by its value at each cell's centre.
+inline constexpr float kSearch = 1.0e4f;
+bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3& lo, glm::vec3& hi);
 
 }  // namespace sdfc::mesh

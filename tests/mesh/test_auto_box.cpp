@@ -1,0 +1,62 @@
+// The box a mesh is made in when none is given (runtime/mesh/auto_box.cpp): the shapes'
+// bounds, or the intervals' for a custom field, floors left out; none for what is unbounded.
+#include <catch2/catch.hpp>
+
+#include "mesh_checks.hpp"
+#include "support.hpp"
+
+using namespace sdfc;
+using namespace sdfc::test;
+
+namespace {
+
+struct Box {
+    bool found = false;
+    glm::vec3 lo{0.0f}, hi{0.0f};
+};
+
+Box box_of(const std::string& src) {
+    auto c = compile_text(src);
+    Box b;
+    b.found = mesh::default_box(c->cs, b.lo, b.hi);
+    return b;
+}
+
+// lo..hi holds want_lo..want_hi with at most `slack` to spare on each side.
+void check_holds(const Box& b, glm::vec3 want_lo, glm::vec3 want_hi, float slack) {
+    REQUIRE(b.found);
+    INFO("box " << b.lo.x << " " << b.lo.y << " " << b.lo.z << " .. " << b.hi.x << " " << b.hi.y << " " << b.hi.z);
+    CHECK(glm::all(glm::lessThanEqual(b.lo, want_lo)));
+    CHECK(glm::all(glm::greaterThanEqual(b.hi, want_hi)));
+    CHECK(glm::all(glm::greaterThanEqual(b.lo, want_lo - slack)));
+    CHECK(glm::all(glm::lessThanEqual(b.hi, want_hi + slack)));
+}
+
+}  // namespace
+
+TEST_CASE("auto box: a custom field's box comes from the intervals", "[mesh]") {
+    check_holds(box_of("field (p) -> length(p - [3, 0, 0]) - 1;"), {2, -1, -1}, {4, 1, 1}, 0.25f);
+    // A smooth blend of custom fields, whose plain intervals are weak far away.
+    check_holds(box_of("smooth_union(0.3) { field (p) -> length(p) - 1; translate([2, 0, 0]) field (p) -> length(p) - 0.5; }"),
+                {-1, -1, -1}, {2.5f, 1, 1}, 0.35f);
+}
+
+TEST_CASE("auto box: floors are left out of a custom field scene's box, then cut into a base", "[mesh]") {
+    const std::string src = "plane([0, 1, 0], -1); field (p) -> length(p) - 0.5;";
+    const Box b = box_of(src);
+    check_holds(b, {-0.5f, -0.5f, -0.5f}, {0.5f, 0.5f, 0.5f}, 0.15f);
+    auto c = compile_text(src);
+    mesh::MeshOptions o;
+    REQUIRE(mesh::default_box(c->cs, o.lo, o.hi));
+    o.resolution = 24;
+    const mesh::Mesh m = mesh::mesh_scene(c->cs, o);
+    CHECK(bad_edges(m) == 0);
+    CHECK(euler(m) == 2);  // the ball (the floor, at y = -1, is outside the box)
+}
+
+TEST_CASE("auto box: unbounded scenes have none", "[mesh]") {
+    CHECK_FALSE(box_of("plane([0, 1, 0], 0);").found);
+    CHECK_FALSE(box_of("field (p) -> p.y;").found);
+    CHECK_FALSE(box_of("repeat([2, 2, 2]) sphere(0.5);").found);
+    CHECK_FALSE(box_of("field (p) -> 1;").found);  // no surface anywhere
+}
