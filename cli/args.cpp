@@ -43,6 +43,24 @@ std::optional<std::string> Args::value(const std::string& name, const std::strin
     return v;
 }
 
+std::vector<std::string> Args::values(const std::string& name) {
+    known_.push_back(name);
+    std::vector<std::string> out;
+    for (size_t i = 0; i < end_; ++i) {
+        if (used_[i]) continue;
+        const std::string& a = args_[i];
+        if (a == name) {
+            if (i + 1 >= end_) throw UsageError(fmt::format("{} needs a value", name));
+            used_[i] = used_[i + 1] = true;
+            out.push_back(args_[++i]);
+        } else if (a.size() > name.size() && a.rfind(name, 0) == 0) {
+            used_[i] = true;
+            out.push_back(a.substr(name.size()));
+        }
+    }
+    return out;
+}
+
 std::vector<std::string> Args::positionals() {
     std::vector<std::string> out;
     for (size_t i = 0; i < args_.size(); ++i) {

@@ -26,6 +26,8 @@ public:
 
     bool flag(const std::string& name);  // --name (no value)
     std::optional<std::string> value(const std::string& name, const std::string& alt = "");  // --name V or --name=V
+    // Every value of a short option that may repeat: -D V, -DV.
+    std::vector<std::string> values(const std::string& name);
     // Everything not consumed (call last): an unknown option is an error naming the nearest
     // option this command asked for; after `--` every argument is a positional.
     std::vector<std::string> positionals();

@@ -1,5 +1,7 @@
 #include "cli/common.hpp"
 
+#include <cctype>
+
 #include <algorithm>
 #include <cstdio>
 #include <thread>
@@ -27,6 +29,18 @@ Common read_common(Args& a) {
     if (auto v = a.value("--max-nesting")) l.max_nesting = Args::to_int("--max-nesting", *v, 1, 10000);
     if (auto v = a.value("--max-pixels")) c.max_pixels = Args::to_int("--max-pixels", *v, 1, 2000000000);
     if (auto v = a.value("--max-frames")) c.max_frames = Args::to_int("--max-frames", *v, 1, 100000000);
+    // -D name=value (OpenSCAD's flag): the script's top-level `let name` takes the value.
+    for (const std::string& d : a.values("-D")) {
+        const size_t eq = d.find('=');
+        const std::string name = d.substr(0, eq);
+        bool ident = !name.empty() && !std::isdigit(static_cast<unsigned char>(name[0]));
+        for (char ch : name) ident &= std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+        if (eq == std::string::npos || !ident || eq + 1 == d.size())
+            throw UsageError(fmt::format("-D takes NAME=VALUE (a top-level let of the script and an expression), not '{}'", d));
+        for (const Define& seen : c.interp.defines)
+            if (seen.name == name) throw UsageError(fmt::format("-D {} is given twice", name));
+        c.interp.defines.push_back({name, d.substr(eq + 1)});
+    }
     return c;
 }
 

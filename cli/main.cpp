@@ -43,6 +43,8 @@ usage:
   sdfc render SCENE... -o OUT [--width W] [--height H] [--samples N] [--time T]
               [--frames A:B --fps F] [--aov depth,normal,steps] [--view steps]
               [--threads N] [--camera-position X,Y,Z] [--camera-target X,Y,Z] [--fov DEG] [--quiet]
+              [--max-steps N] [--max-bounces N] [--max-distance D] [--epsilon E] [--shadows on|off]
+              [--ao on|off] [--aa grid|cone]   (render(...)'s settings; also for bench)
               OUT may contain {frame:04d} (or {frame}) and {name} (the scene's file stem)
   sdfc glsl    SCENE [--target shadertoy|glsl330|html] [-o OUT]
   sdfc compile SCENE --emit ast|ir|bytecode
@@ -64,6 +66,8 @@ SCENE is a .sdf script or a .vm model (Prospero/Fidget flat SSA format).
 Safety limits (defaults in docs/language.md): --max-recursion N, --max-iterations N,
 --max-calls N, --max-shapes N, --max-shape-depth N, --max-ops N, --max-file-size BYTES,
 --max-pixels N (width*height*samples), --max-frames N, --max-nesting N.
+Every command: -D NAME=VALUE sets the script's top-level `let NAME` to VALUE (an
+expression: -D size=2, -D 'color=[1, 0, 0]'), as OpenSCAD's -D does.
 )";
 
 // `{frame:04d}`, `{frame}` and `{name}` in an output path.
@@ -94,6 +98,9 @@ std::string expand(std::string out, int frame, const std::string& name) {
 // The scene flags a command took out of its arguments (flag, value if given): they override
 // the script's settings of each scene it compiles.
 using Overrides = std::vector<std::pair<std::string, std::optional<std::string>>>;
+// The flags that override the script's camera and render(...) settings (render and bench).
+constexpr const char* kOverrideFlags[] = {"--width",     "--height",  "--samples", "--camera-position", "--camera-target", "--fov",
+                                          "--max-steps", "--max-bounces", "--max-distance", "--epsilon", "--shadows", "--ao", "--aa"};
 
 bool ov_has(const Overrides& ov, const char* flag) {
     for (auto& [k, v] : ov)
@@ -111,6 +118,23 @@ void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
     if (auto v = a.value("--width")) cs.render.width = Args::to_int("--width", *v, 1, 16384), sized = true;
     if (auto v = a.value("--height")) cs.render.height = Args::to_int("--height", *v, 1, 16384), sized = true;
     if (auto v = a.value("--samples")) cs.render.samples = Args::to_int("--samples", *v, 1, 4096), sized = true;
+    // The rest of render(...): the same names and ranges as the script's.
+    if (auto v = a.value("--max-steps")) cs.render.max_steps = Args::to_int("--max-steps", *v, 1, 100000);
+    if (auto v = a.value("--max-bounces")) cs.render.max_bounces = Args::to_int("--max-bounces", *v, 0, 64);
+    for (auto [flag, field] : {std::pair{"--max-distance", &cs.render.max_distance}, std::pair{"--epsilon", &cs.render.epsilon}})
+        if (auto v = a.value(flag)) {
+            *field = Args::to_float(flag, *v);
+            if (!(*field > 0.0f)) throw UsageError(fmt::format("{} must be above 0, not {}", flag, *v));
+        }
+    for (auto [flag, field] : {std::pair{"--shadows", &cs.render.shadows}, std::pair{"--ao", &cs.render.ao}})
+        if (auto v = a.value(flag)) {
+            if (*v != "on" && *v != "off") throw UsageError(fmt::format("{} takes on or off, not '{}'", flag, *v));
+            *field = *v == "on";
+        }
+    if (auto v = a.value("--aa")) {
+        if (*v != "grid" && *v != "cone") throw UsageError(fmt::format("--aa takes grid or cone, not '{}'", *v));
+        cs.render.aa = *v;
+    }
     if (auto v = a.value("--camera-position")) {
         auto f = Args::to_floats("--camera-position", *v, 3);
         cs.camera.position = {f[0], f[1], f[2]};
@@ -152,7 +176,7 @@ int cmd_render(Args& a) {
     bool baseline = a.flag("--baseline");  // hidden: every acceleration off (issue 6)
     // Overrides are read per scene below; take them out of the positionals first.
     Overrides ov;
-    for (const char* f : {"--width", "--height", "--samples", "--camera-position", "--camera-target", "--fov"}) ov.emplace_back(f, a.value(f));
+    for (const char* f : kOverrideFlags) ov.emplace_back(f, a.value(f));
     auto scenes = a.positionals();
     if (scenes.empty()) throw UsageError("render needs a scene file");
     if (!out) throw UsageError("render needs -o OUT");
@@ -411,7 +435,7 @@ int cmd_bench(Args& a) {
     auto threads = a.value("--threads");
     bool baseline = a.flag("--baseline");
     Overrides ov;
-    for (const char* f : {"--width", "--height", "--samples"}) ov.emplace_back(f, a.value(f));
+    for (const char* f : kOverrideFlags) ov.emplace_back(f, a.value(f));
     std::string path = one_scene(a, "bench");
     int n = repeat ? Args::to_int("--repeat", *repeat, 1, 100000) : 5;
     SourceManager sm;
@@ -505,6 +529,9 @@ int run(int argc, char** argv) {
         std::fwrite(s.data(), 1, s.size(), stderr);
         return 1;
     } catch (const sdfc::cli::UsageError& e) {  // the command line, not the script: exit 2
+        std::fprintf(stderr, "sdfc: error: %s\n", e.what());
+        return 2;
+    } catch (const sdfc::DefineError& e) {  // a -D the script cannot take: the command line too
         std::fprintf(stderr, "sdfc: error: %s\n", e.what());
         return 2;
     } catch (const std::exception& e) {

@@ -128,6 +128,12 @@ public:
     void check_limit_iterations(long n, Loc loc);
     void count_calls(size_t n, Loc loc);  // function calls, field bodies, shapes applied to points
 
+    // -D: the main script's top-level env, which defines were used, and the override.
+    Env* main_env = nullptr;
+    std::vector<bool> define_used;
+    Value defined_value(size_t k, const ast::Stmt& let, Env* env);
+    void check_defines_used(Env* top);
+
     SourceManager& sm;
     InterpretOptions opts;
     std::shared_ptr<Graph> g;

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "compiler/scene/lower.hpp"
+#include "compiler/base/names.hpp"
 #include "lang/interp.hpp"
 
 namespace sdfc {
@@ -152,6 +153,8 @@ Scene Interp::run(const SourceFile& file) {
     modules.push_back(ast::parse(file, ast::ParseOptions{opts.limits.max_nesting}));
     const ast::Module& m = *modules.back();
     Env* top = new_env(nullptr);
+    main_env = top;
+    define_used.assign(opts.defines.size(), false);
     std::error_code ec;  // the file was read, so only a race fails here; its own path stands in
     auto key = std::filesystem::weakly_canonical(file.path, ec);
     import_stack.push_back(ec ? file.path : key.string());
@@ -176,8 +179,46 @@ Scene Interp::run(const SourceFile& file) {
         }
     }
     if (!errors.empty()) throw CompileError(std::move(errors));
+    check_defines_used(top);
     scene.root = union_of(std::move(shapes), Loc{&file, 1, 1});
     return scene;
+}
+
+// The -D value for the main script's `let`, parsed and evaluated where the let is, and of
+// the same kind as the script's own value.
+Value Interp::defined_value(size_t k, const ast::Stmt& let, Env* env) {
+    const Define& d = opts.defines[k];
+    define_used[k] = true;
+    const std::string what = fmt::format("-D {}={}", d.name, d.value);
+    try {
+        const SourceFile& f = sm.add("-D " + d.name, d.value + ";");
+        modules.push_back(ast::parse(f, ast::ParseOptions{opts.limits.max_nesting}));
+        const ast::Module& m = *modules.back();
+        if (m.stmts.size() != 1 || m.stmts[0]->kind != ast::StmtKind::Expr || !m.stmts[0]->value)
+            throw DefineError(fmt::format("{}: the value must be one expression", what));
+        Value v = eval(*m.stmts[0]->value, env);
+        Value own = eval(*let.value, env);
+        if (v.t != own.t || v.n != own.n)
+            throw DefineError(fmt::format("{}: the script's '{}' (line {}) is {}, not {}", what, d.name, let.name_loc.line, describe(own),
+                                          describe(v)));
+        return v;
+    } catch (const CompileError& e) {
+        const auto& diags = e.diagnostics();
+        throw DefineError(fmt::format("{}: {}", what, diags.empty() ? std::string("not a value") : diags.front().message));
+    }
+}
+
+void Interp::check_defines_used(Env* top) {
+    for (size_t k = 0; k < opts.defines.size(); ++k) {
+        if (define_used[k]) continue;
+        std::vector<std::string> names;
+        for (const auto& [name, b] : top->vars)
+            if (b.value.t != VT::Function) names.push_back(name);
+        const std::string& n = opts.defines[k].name;
+        const std::string near = nearest_name(n, names);
+        throw DefineError(near.empty() ? fmt::format("-D {}: the script has no top-level `let {}`", n, n)
+                                       : fmt::format("-D {}: the script has no top-level `let {}` (did you mean `{}`?)", n, n, near));
+    }
 }
 
 // ---------------------------------------------------------------- statements
@@ -230,7 +271,12 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             auto it = env->vars.find(s.name);
             if (it != env->vars.end())
                 fail(s.name_loc, fmt::format("'{}' is already defined in this scope (at line {})", s.name, it->second.loc.line));
-            Value v = eval(*s.value, env);
+            Value v;
+            bool defined = false;
+            if (env == main_env && s.kind == ast::StmtKind::Let)
+                for (size_t k = 0; k < opts.defines.size() && !defined; ++k)
+                    if (opts.defines[k].name == s.name) v = defined_value(k, s, env), defined = true;
+            if (!defined) v = eval(*s.value, env);
             env->vars[s.name] = Binding{std::move(v), s.kind == ast::StmtKind::Var, s.name_loc};
             return;
         }

@@ -2,6 +2,9 @@
 // produces the Scene. Numbers are evaluated symbolically into the IR Graph, so custom
 // fields, `time` in GLSL and the point `p` are expressions, and script constants fold away.
 #pragma once
+#include <stdexcept>
+#include <string>
+#include <vector>
 #include <optional>
 #include <string>
 
@@ -22,9 +25,22 @@ struct Limits {
     size_t max_file_bytes = 16u << 20;    // per source file
 };
 
+// `-D name=value` on the command line: the value (an expression) replaces the one of the
+// main script's top-level `let name`.
+struct Define {
+    std::string name, value;
+};
+
 struct InterpretOptions {
     std::optional<float> time = 0.0f;  // nullopt: `time` stays symbolic (GLSL)
     Limits limits;
+    std::vector<Define> defines;
+};
+
+// A -D the script cannot take (no such let, a value of another kind, not an expression):
+// a command-line error, not the script's.
+struct DefineError : std::runtime_error {
+    using std::runtime_error::runtime_error;
 };
 
 // Loads, parses and runs the script at `path`. Throws CompileError with every diagnostic

@@ -132,7 +132,10 @@ Scene load_vm(SourceManager&, const SourceFile& file) {
 }
 
 Scene load_scene(SourceManager& sm, const std::string& path, const InterpretOptions& opts) {
-    if (is_vm_path(path)) return load_vm(sm, sm.load(path, Loc{}, opts.limits.max_file_bytes));
+    if (is_vm_path(path)) {
+        if (!opts.defines.empty()) throw DefineError(fmt::format("-D {}: a .vm model has no `let` to set", opts.defines.front().name));
+        return load_vm(sm, sm.load(path, Loc{}, opts.limits.max_file_bytes));
+    }
     return interpret_file(sm, path, opts);
 }
 
