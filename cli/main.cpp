@@ -40,7 +40,7 @@ namespace {
 const char* kUsage = R"(sdfc — compile and render .sdf signed-distance-field scenes
 
 usage:
-  sdfc render SCENE... -o OUT [--width W] [--height H] [--samples N] [--time T]
+  sdfc render SCENE... -o OUT [--format F] [--width W] [--height H] [--samples N] [--time T]
               [--frames A:B --fps F] [--aov depth,normal,steps] [--view steps]
               [--threads N] [--camera-position X,Y,Z] [--camera-target X,Y,Z] [--fov DEG] [--quiet]
               [--max-steps N] [--max-bounces N] [--max-distance D] [--epsilon E] [--shadows on|off]
@@ -50,8 +50,8 @@ usage:
   sdfc compile SCENE --emit ast|ir|bytecode
   sdfc check   SCENE
   sdfc eval    SCENE (--at X,Y,Z | --points FILE) [--time T]
-  sdfc slice   SCENE --axis x|y|z --at V -o OUT [--range UMIN,UMAX,VMIN,VMAX] [--width W] [--height H]
-  sdfc mesh    SCENE -o OUT.stl|obj|ply|3mf [--resolution N | --cell SIZE] [--bounds X0,Y0,Z0,X1,Y1,Z1]
+  sdfc slice   SCENE --axis x|y|z --at V -o OUT [--format F] [--range UMIN,UMAX,VMIN,VMAX] [--width W] [--height H]
+  sdfc mesh    SCENE -o OUT.stl|obj|ply|3mf [--format F] [--resolution N | --cell SIZE] [--bounds X0,Y0,Z0,X1,Y1,Z1]
               [--simplify TOL] [--time T] [--threads N] [--max-triangles N] [--max-cells N] [--error] [--quiet]
               dual contouring: closed, sharp-edged; OBJ, PLY and 3MF carry the materials' colours;
               --simplify: fewer triangles, all within TOL of the surface;
@@ -62,13 +62,27 @@ usage:
               (tape=MEAN/FULL) and the tape tree; --baseline: plain Hart sphere tracing
   sdfc --help | --version | CMD --help
 
-SCENE is a .sdf script or a .vm model (Prospero/Fidget flat SSA format).
+SCENE is a .sdf script or a .vm model (Prospero/Fidget flat SSA format); - reads a script
+from standard input (its imports relative to the working folder). -o - writes to standard
+output: render, slice and mesh then take --format (png, exr, ...; stl, obj, ply, 3mf).
 Safety limits (defaults in docs/language.md): --max-recursion N, --max-iterations N,
 --max-calls N, --max-shapes N, --max-shape-depth N, --max-ops N, --max-file-size BYTES,
 --max-pixels N (width*height*samples), --max-frames N, --max-nesting N.
 Every command: -D NAME=VALUE sets the script's top-level `let NAME` to VALUE (an
 expression: -D size=2, -D 'color=[1, 0, 0]'), as OpenSCAD's -D does.
 )";
+
+// --format: the image format of standard output (-o -); a file's extension names its own.
+std::string image_format_flag(const std::string& out, const std::optional<std::string>& format) {
+    if (out == "-") {
+        if (!format) throw UsageError("-o - (standard output) needs --format (png, jpg, exr, hdr, tif, ...)");
+        std::string f = *format;
+        if (!f.empty() && f[0] == '.') f.erase(0, 1);
+        return f;
+    }
+    if (format) throw UsageError(fmt::format("--format is for -o - (standard output); the extension of '{}' names its format", out));
+    return "";
+}
 
 // `{frame:04d}`, `{frame}` and `{name}` in an output path.
 std::string expand(std::string out, int frame, const std::string& name) {
@@ -174,12 +188,14 @@ int cmd_render(Args& a) {
     auto view = a.value("--view");
     bool quiet = a.flag("--quiet") || a.flag("-q");
     bool baseline = a.flag("--baseline");  // hidden: every acceleration off (issue 6)
+    auto format = a.value("--format");
     // Overrides are read per scene below; take them out of the positionals first.
     Overrides ov;
     for (const char* f : kOverrideFlags) ov.emplace_back(f, a.value(f));
     auto scenes = a.positionals();
     if (scenes.empty()) throw UsageError("render needs a scene file");
     if (!out) throw UsageError("render needs -o OUT");
+    const std::string fmt_ext = image_format_flag(*out, format);
     RenderOptions ro;
     ro.baseline = baseline;
     if (threads) ro.threads = thread_count(*threads);
@@ -216,14 +232,16 @@ int cmd_render(Args& a) {
     }
     if (scenes.size() > 1 && out->find("{name}") == std::string::npos)
         throw UsageError("rendering several scenes needs {name} in the output name");
+    if (*out == "-" && !ro.aovs.empty() && fmt_ext != "exr")
+        throw UsageError("--aov to standard output needs --format exr (as channels: side files need a file name)");
     // The outputs can be written (folder, format, not a directory...) before any work.
     for (const std::string& path : scenes) {
         std::string name = std::filesystem::path(path).stem().string();
         for (int f : {f0, f1}) {
             std::string target = expand(*out, f, name);
-            check_image_output(target);
+            check_image_output(target, fmt_ext);
             check_not_input(target, path);
-            if (!is_exr(target))
+            if (!is_exr(target) && target != "-")
                 for (const std::string& av : ro.aovs) check_image_output(aov_side_path(target, av));
         }
     }
@@ -257,7 +275,7 @@ int cmd_render(Args& a) {
             CompiledScene cs = compile_frame(sm, path, f);
             std::string target = expand(*out, f, name);
             check_not_input(target, sm);
-            if (!is_exr(target))
+            if (!is_exr(target) && target != "-")
                 for (const std::string& av : ro.aovs) check_not_input(aov_side_path(target, av), sm);
             // A progress bar with ETA on a terminal, for renders past a second; the summary
             // line below either way (unless --quiet).
@@ -274,8 +292,10 @@ int cmd_render(Args& a) {
             Image img = cs.is_2d ? render_2d(cs, cs.render.width, cs.render.height, ro.threads, baseline) : render(cs, ro);
             double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
             if (bar) std::fputs("\r\033[K", stderr);
-            write_image(target, img);
-            if (!quiet) std::fprintf(stderr, "sdfc: wrote %s (%dx%d, %.1f ms)\n", target.c_str(), img.width, img.height, ms);
+            write_image(target, img, WriteOptions{true, fmt_ext});
+            if (!quiet)
+                std::fprintf(stderr, "sdfc: wrote %s (%dx%d, %.1f ms)\n", target == "-" ? "standard output" : target.c_str(), img.width,
+                             img.height, ms);
         }
     }
     return 0;
@@ -297,7 +317,7 @@ int cmd_compile(Args& a) {
     SourceManager sm;
     if (*emit == "ast") {
         if (is_vm_path(path)) throw UsageError("--emit ast needs a .sdf script");
-        const SourceFile& f = sm.load(path, Loc{}, c.interp.limits.max_file_bytes);
+        const SourceFile& f = path == "-" ? sm.load_stdin(c.interp.limits.max_file_bytes) : sm.load(path, Loc{}, c.interp.limits.max_file_bytes);
         auto m = ast::parse(f, ast::ParseOptions{c.interp.limits.max_nesting});
         std::cout << ast::dump(*m);
         interpret_source(sm, f, c.interp);  // report semantic errors too
@@ -373,8 +393,10 @@ int cmd_slice(Args& a) {
     auto w = a.value("--width");
     auto h = a.value("--height");
     auto time_s = a.value("--time");
+    auto format = a.value("--format");
     std::string path = one_scene(a, "slice");
     if (!out) throw UsageError("slice needs -o OUT");
+    const std::string fmt_ext = image_format_flag(*out, format);
     SliceOptions so;
     if (axis) {
         if (*axis != "x" && *axis != "y" && *axis != "z") throw UsageError(fmt::format("--axis takes x, y or z, not '{}'", *axis));
@@ -390,12 +412,12 @@ int cmd_slice(Args& a) {
     if (h) so.height = Args::to_int("--height", *h, 1, 16384);
     if (double(so.width) * so.height > double(c.max_pixels))
         throw UsageError(fmt::format("{}x{} pixels is over the limit of {} (raise it with --max-pixels)", so.width, so.height, c.max_pixels));
-    check_image_output(*out);
+    check_image_output(*out, fmt_ext);
     check_not_input(*out, path);
     SourceManager sm;
     CompiledScene cs = build(sm, path, c, time_s ? Args::to_float("--time", *time_s) : 0.0f);
     check_not_input(*out, sm);
-    write_image(*out, render_slice(cs, so));
+    write_image(*out, render_slice(cs, so), WriteOptions{true, fmt_ext});
     return 0;
 }
 

@@ -76,6 +76,7 @@ int cmd_mesh(Args& a) {
     auto simplify = a.value("--simplify");
     bool quiet = a.flag("--quiet") || a.flag("-q");
     bool error_stats = a.flag("--error");
+    auto format = a.value("--format");
     std::string path = one_scene(a, "mesh");
     if (!out) throw UsageError("mesh needs -o OUT (.stl, .obj, .ply or .3mf)");
     if (res && cell) throw UsageError("--resolution and --cell are two ways to say the same: give one");
@@ -94,8 +95,14 @@ int cmd_mesh(Args& a) {
         if (!(cell_limit >= 1.0 && cell_limit <= double(1ull << 36)))
             throw UsageError(fmt::format("--max-cells must be from 1 to {}, not {}", 1ull << 36, *max_cells));
     }
-    if (mesh::mesh_format(*out) == mesh::MeshFormat::Unknown)
-        throw UsageError(fmt::format("cannot write '{}': unknown mesh format (use .stl, .obj, .ply or .3mf)", *out));
+    if (*out == "-" && !format) throw UsageError("-o - (standard output) needs --format (stl, obj, ply or 3mf)");
+    if (*out == "-" && error_stats) throw UsageError("--error prints to standard output: it cannot go with -o -");
+    if (*out != "-" && format)
+        throw UsageError(fmt::format("--format is for -o - (standard output); the extension of '{}' names its format", *out));
+    const mesh::MeshFormat mf = mesh::mesh_format(*out == "-" ? "stdout." + *format : *out);
+    if (mf == mesh::MeshFormat::Unknown)
+        throw UsageError(*out == "-" ? fmt::format("--format {}: unknown mesh format (use stl, obj, ply or 3mf)", *format)
+                                     : fmt::format("cannot write '{}': unknown mesh format (use .stl, .obj, .ply or .3mf)", *out));
     resolve_output(*out);
     check_not_input(*out, path);
     std::unique_ptr<tbb::global_control> limit;
@@ -130,7 +137,7 @@ int cmd_mesh(Args& a) {
     const double cells = mesh::grid_cells(mo);
     if (cells > cell_limit)
         throw UsageError(fmt::format("a grid of {:.0f} cells is over the limit of {:.0f} (raise it with --max-cells)", cells, cell_limit));
-    mo.colors = mesh::mesh_format(*out) != mesh::MeshFormat::Stl;
+    mo.colors = mf != mesh::MeshFormat::Stl;
     auto t0 = std::chrono::steady_clock::now();
     bool bar = false;  // as render's: on a terminal, for meshes past a second
     if (!quiet && isatty(fileno(stderr))) {
@@ -145,7 +152,7 @@ int cmd_mesh(Args& a) {
     mesh::Mesh m = mesh::mesh_scene(cs, mo, &st);
     double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (bar) std::fputs("\r\033[K", stderr);
-    mesh::write_mesh(*out, m);
+    write_file(*out, mesh::encode_mesh(m, mf));
     if (error_stats && !m.positions.empty()) {
         std::vector<glm::vec3> centroids;
         for (const auto& tri : m.triangles) centroids.push_back((m.positions[tri[0]] + m.positions[tri[1]] + m.positions[tri[2]]) / 3.0f);
@@ -165,7 +172,7 @@ int cmd_mesh(Args& a) {
                      path.c_str(), mo.resolution);
     if (!quiet)
         std::fprintf(stderr, "sdfc: wrote %s (%zu triangles%s, %zu vertices, %d cells across, %zu of %zu bricks sampled, %.1f ms)\n",
-                     out->c_str(), m.triangles.size(),
+                     *out == "-" ? "standard output" : out->c_str(), m.triangles.size(),
                      simplify ? fmt::format(" simplified from {}", st.unsimplified_triangles).c_str() : "", m.positions.size(),
                      mo.resolution, st.active_bricks + st.rescued_bricks, st.bricks, ms);
     return 0;

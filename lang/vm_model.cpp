@@ -132,6 +132,7 @@ Scene load_vm(SourceManager&, const SourceFile& file) {
 }
 
 Scene load_scene(SourceManager& sm, const std::string& path, const InterpretOptions& opts) {
+    if (path == "-") return interpret_source(sm, sm.load_stdin(opts.limits.max_file_bytes), opts);
     if (is_vm_path(path)) {
         if (!opts.defines.empty()) throw DefineError(fmt::format("-D {}: a .vm model has no `let` to set", opts.defines.front().name));
         return load_vm(sm, sm.load(path, Loc{}, opts.limits.max_file_bytes));

@@ -1,5 +1,9 @@
 #include "compiler/base/source.hpp"
 
+#include <unistd.h>
+
+#include <optional>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdint>
@@ -144,6 +148,30 @@ const SourceFile& SourceManager::load(const std::string& path, Loc from, size_t 
     // A UTF-8 byte-order mark is no text: columns of the first line count from after it.
     if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
     const SourceFile& f = add(path, std::move(text));
+    check_source_text(f);
+    return f;
+}
+
+const SourceFile& SourceManager::load_stdin(size_t max_bytes) {
+    static std::optional<std::string> cached;
+    if (!cached) {
+        std::string text;
+        char buf[1 << 16];
+        for (;;) {
+            const ssize_t n = ::read(STDIN_FILENO, buf, sizeof buf);
+            if (n < 0 && errno == EINTR) continue;
+            if (n < 0) throw CompileError(Loc{}, fmt::format("cannot read standard input: {}", std::strerror(errno)));
+            if (n == 0) break;
+            text.append(buf, size_t(n));
+            if (text.size() > max_bytes)
+                throw CompileError(Loc{}, fmt::format("standard input is over the limit of {} bytes (--max-file-size)", max_bytes));
+        }
+        if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
+        cached = std::move(text);
+    }
+    if (cached->size() > max_bytes)
+        throw CompileError(Loc{}, fmt::format("standard input is over the limit of {} bytes (--max-file-size)", max_bytes));
+    const SourceFile& f = add("<stdin>", *cached);
     check_source_text(f);
     return f;
 }

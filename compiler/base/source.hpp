@@ -66,6 +66,10 @@ public:
     // or for binary/invalid UTF-8 content or a file over `max_bytes`.
     const SourceFile& load(const std::string& path, Loc from = {}, size_t max_bytes = 16u << 20);
     const SourceFile& add(std::string path, std::string text);
+    // The script on standard input, as "<stdin>" (its imports are relative to the working
+    // folder), with load's checks. Standard input is read once per process: later calls
+    // (a scene compiled again per frame) get the same text.
+    const SourceFile& load_stdin(size_t max_bytes = 16u << 20);
     // The path of every file loaded or added so far, the first one first (cli/: an output
     // must not overwrite one of them).
     std::vector<std::string> paths() const {

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -128,6 +129,10 @@ OutputTarget resolve_output(const std::string& path) {
     OutputTarget t;
     t.path = t.file = path;
     if (path.empty()) fail(path, "the output path is empty");
+    if (path == "-") {  // standard output, written through
+        t.write_through = true;
+        return t;
+    }
     struct stat st {};
     if (::lstat(path.c_str(), &st) == 0 && S_ISLNK(st.st_mode)) {
         // The link stays a link: what it points to is written (created if it dangles).
@@ -165,6 +170,17 @@ OutputTarget resolve_output(const std::string& path) {
 }
 
 void write_file(const std::string& path, std::string_view bytes) {
+    if (path == "-") {
+        // After what the program printed there itself.
+        std::fflush(stdout);
+        try {
+            write_all(STDOUT_FILENO, bytes.data(), bytes.size(), path);
+        } catch (const std::runtime_error& e) {
+            const std::string what = e.what(), prefix = "cannot write '-': ";
+            throw std::runtime_error("cannot write to standard output: " + (what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what));
+        }
+        return;
+    }
     const OutputTarget t = resolve_output(path);
     if (t.write_through) {
         int fd = ::open(t.file.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);

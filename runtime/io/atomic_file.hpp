@@ -4,7 +4,7 @@
 // replaced only by a complete one. A symlink keeps being a link (its target is replaced);
 // a character device or FIFO is written through, the way Unix tools do; anything else that
 // is not a regular file (a directory, a socket) is refused. Every error names the user's
-// path and the OS reason: "cannot write 'PATH': REASON".
+// path and the OS reason: "cannot write 'PATH': REASON". The path "-" is standard output.
 #pragma once
 #include <string>
 #include <string_view>

@@ -77,7 +77,7 @@ const ImageBackend& backend() {
 
 void write_image(const std::string& path, const Image& img, const WriteOptions& opt) { backend().write_image(path, img, opt); }
 
-void check_image_output(const std::string& path) { backend().check_image_output(path); }
+void check_image_output(const std::string& path, const std::string& format) { backend().check_image_output(path, format); }
 
 Image read_image(const std::string& path) { return backend().read_image(path); }
 

@@ -42,6 +42,7 @@ struct Image {
 
 struct WriteOptions {
     bool aov_side_files = true;  // non-EXR formats: write STEM.NAME.png for each AOV plane
+    std::string format;          // for the path "-" (standard output): the format's extension, "png"
 };
 
 // Throws std::runtime_error (with the path and the reason) on failure; the target is then
@@ -50,8 +51,9 @@ void write_image(const std::string& path, const Image& img, const WriteOptions& 
 
 // The checks write_image makes before it encodes anything, for callers to make before the
 // work: the path can be written (resolve_output) and its extension names an image format
-// OpenImageIO writes. Throws std::runtime_error "cannot write 'PATH': REASON".
-void check_image_output(const std::string& path);
+// OpenImageIO writes (for "-", standard output, `format` names it). Throws
+// std::runtime_error "cannot write 'PATH': REASON".
+void check_image_output(const std::string& path, const std::string& format = "");
 
 // Reads any format OpenImageIO knows. 8-bit (and other integer) files are decoded from sRGB
 // to linear; float files are taken as linear. Channels named Z / N.x N.y N.z / steps become

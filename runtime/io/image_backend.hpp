@@ -8,12 +8,12 @@
 
 namespace sdfc {
 
-inline constexpr int kImageBackendVersion = 1;
+inline constexpr int kImageBackendVersion = 2;
 
 struct ImageBackend {
     int version;
     void (*write_image)(const std::string& path, const Image& img, const WriteOptions& opt);
-    void (*check_image_output)(const std::string& path);
+    void (*check_image_output)(const std::string& path, const std::string& format);
     Image (*read_image)(const std::string& path);
 };
 

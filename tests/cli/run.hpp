@@ -40,12 +40,12 @@ inline std::string write_temp(const std::string& name, const std::string& text) 
 }
 
 // Runs `sdfc ARGS` (a shell-quoted string) and captures everything; `env` ("NAME=value
-// ...") goes before the command.
-inline RunResult run_sdfc(const std::string& args, const std::string& env = "") {
+// ...") goes before the command; `input` (a file) is its standard input.
+inline RunResult run_sdfc(const std::string& args, const std::string& env = "", const std::string& input = "/dev/null") {
     const char* bin = std::getenv("SDFC_BIN");  // override: test another build of sdfc
     std::string exe = bin ? bin : SDFC_BIN_PATH;
     std::string out = temp_dir() + "/stdout.txt", err = temp_dir() + "/stderr.txt";
-    std::string cmd = env + (env.empty() ? "" : " ") + "'" + exe + "' " + args + " >'" + out + "' 2>'" + err + "' </dev/null";
+    std::string cmd = env + (env.empty() ? "" : " ") + "'" + exe + "' " + args + " >'" + out + "' 2>'" + err + "' <'" + input + "'";
     int st = std::system(cmd.c_str());
     RunResult r;
     r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;

@@ -98,7 +98,8 @@ void verify_file(const std::string& path, const std::string& file, int width, in
 // extension names, checks it decodes, and writes it with write_file (checked, atomic).
 // In memory where the format's writer takes an IOProxy; otherwise through a temporary
 // file in the system's temporary folder, read back.
-void write_atomic(const std::string& path, int width, int height, const std::vector<std::string>& names,
+// `as` names the format (the path itself, or "stdout.png" for standard output).
+void write_atomic(const std::string& path, const std::string& as, int width, int height, const std::vector<std::string>& names,
                   OIIO::TypeDesc type, const void* data, bool linear) {
     if (width <= 0 || height <= 0) throw std::runtime_error(write_error(path, "the image is empty"));
     OIIO::ImageSpec spec(width, height, static_cast<int>(names.size()), type);
@@ -116,18 +117,18 @@ void write_atomic(const std::string& path, int width, int height, const std::vec
     };
     std::vector<unsigned char> buf;
     bool encoded = false;
-    if (image_output_for(path)->supports("ioproxy")) {
+    if (image_output_for(as)->supports("ioproxy")) {
         OIIO::Filesystem::IOVecOutput vec(buf);
-        auto out = image_output_for(path, &vec);
-        encode(*out, path, "");
+        auto out = image_output_for(as, &vec);
+        encode(*out, as, "");
         out.reset();
-        encoded = decodes_in_memory(path, buf, width, height, int(names.size()));
+        encoded = decodes_in_memory(as, buf, width, height, int(names.size()));
     }
     if (!encoded) {
         // No writer or no reader in memory, or a broken encoding there (this OpenImageIO's
         // TIFF writer through a proxy): encoded to a file and decoded from it.
         const fs::path tmp_dir = fs::temp_directory_path();
-        TempFile tmp(temp_path_for((tmp_dir / fs::path(path).filename()).string()));
+        TempFile tmp(temp_path_for((tmp_dir / fs::path(as).filename()).string()));
         auto out = image_output_for(tmp.path());
         encode(*out, tmp.path(), tmp.path());
         out.reset();
@@ -179,17 +180,27 @@ void write_side_file(const std::string& path, const Image& img, const AovPlane& 
             px[i] = to_u8(t);
         }
     }
-    write_atomic(aov_side_path(path, a.name), img.width, img.height, names, OIIO::TypeDesc::UINT8, px.data(), true);
+    const std::string side = aov_side_path(path, a.name);
+    write_atomic(side, side, img.width, img.height, names, OIIO::TypeDesc::UINT8, px.data(), true);
 }
 
-void oiio_check_image_output(const std::string& path) {
+// The name whose extension picks the format: the path, or for "-" (standard output)
+// "stdout." and the format asked for.
+std::string format_name(const std::string& path, const std::string& format) {
+    if (path != "-") return path;
+    if (format.empty()) throw std::runtime_error("writing an image to standard output (-o -) needs --format (png, jpg, exr, hdr, tif, ...)");
+    return "stdout." + format;
+}
+
+void oiio_check_image_output(const std::string& path, const std::string& format) {
     resolve_output(path);
-    (void)image_output_for(path);
+    (void)image_output_for(format_name(path, format));
 }
 
 void oiio_write_image(const std::string& path, const Image& img, const WriteOptions& opt) {
-    oiio_check_image_output(path);  // before any side file: a bad main path changes nothing
-    const std::string ext = lower_ext(path);
+    oiio_check_image_output(path, opt.format);  // before any side file: a bad main path changes nothing
+    const std::string as = format_name(path, opt.format);
+    const std::string ext = lower_ext(as);
     const size_t n = static_cast<size_t>(std::max(img.width, 0)) * std::max(img.height, 0);
     const int nc = std::clamp(img.channels, 1, 4);
     if (img.pixels.size() < n * img.channels) throw std::runtime_error("cannot write '" + path + "': pixel buffer has the wrong size");
@@ -218,12 +229,14 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
             for (const AovPlane* a : planes)
                 for (int c = 0; c < a->channels; ++c) o[k++] = finite_or_zero(a->data[i * a->channels + c]);
         }
-        write_atomic(path, img.width, img.height, names, OIIO::TypeDesc::FLOAT, buf.data(), true);
+        write_atomic(path, as, img.width, img.height, names, OIIO::TypeDesc::FLOAT, buf.data(), true);
         return;
     }
 
     // Other formats: AOVs go to side files (written first: the main image appearing last
     // means the whole set is complete).
+    if (opt.aov_side_files && !img.aovs.empty() && path == "-")
+        throw std::runtime_error("AOV side files need a file name: write them with -o NAME, or to standard output as --format exr channels");
     if (opt.aov_side_files)
         for (const auto& a : img.aovs) write_side_file(path, img, a);
 
@@ -239,7 +252,7 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
                 float v = finite_or_zero(img.pixels[i * img.channels + std::min(c, oc - 1)]);
                 buf[i * fc + c] = ext == ".hdr" ? std::max(v, 0.0f) : v;
             }
-        write_atomic(path, img.width, img.height, fnames, OIIO::TypeDesc::FLOAT, buf.data(), true);
+        write_atomic(path, as, img.width, img.height, fnames, OIIO::TypeDesc::FLOAT, buf.data(), true);
         return;
     }
     // 8-bit, sRGB-encoded colour; alpha stays linear.
@@ -249,7 +262,7 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
             float v = img.pixels[i * img.channels + c];
             buf[i * oc + c] = to_u8(c == 3 ? v : linear_to_srgb(v));
         }
-    write_atomic(path, img.width, img.height, names, OIIO::TypeDesc::UINT8, buf.data(), false);
+    write_atomic(path, as, img.width, img.height, names, OIIO::TypeDesc::UINT8, buf.data(), false);
 }
 
 Image oiio_read_image(const std::string& path) {
