@@ -30,5 +30,7 @@ int thread_count(const std::string& v);
 void progress_line(const std::string& target, double frac, double elapsed_s, double eta);
 
 int cmd_mesh(Args& a);
+// `sdfc watch` (watch_command.cpp): `run` runs one command line, its errors reported.
+int cmd_watch(const std::vector<std::string>& args, int (*run)(const std::vector<std::string>&));
 
 }  // namespace sdfc::cli

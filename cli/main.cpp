@@ -60,6 +60,9 @@ usage:
               prints median_ms, min_ms, evals_per_pixel (SDF evaluations: rays, normals,
               shadows, ao), shading (material evaluations), the mean program length run
               (tape=MEAN/FULL) and the tape tree; --baseline: plain Hart sphere tracing
+  sdfc watch   [--runs N] [--debounce MS] CMD ARGS...
+              runs the command (render, glsl, check, slice, mesh, eval, compile) again on every
+              save of its scene or of a file it imports; the last good output stays
   sdfc --help | --version | CMD --help
 
 SCENE is a .sdf script or a .vm model (Prospero/Fidget flat SSA format); - reads a script
@@ -508,8 +511,9 @@ std::string command_usage(const std::string& cmd) {
     return out;
 }
 
-int dispatch(int argc, char** argv) {
-    std::vector<std::string> all(argv + 1, argv + argc);
+int run_command(const std::vector<std::string>& all);
+
+int dispatch(const std::vector<std::string>& all) {
     if (all.empty() || all[0] == "--help" || all[0] == "-h" || all[0] == "help") {
         std::fputs(kUsage, all.empty() ? stderr : stdout);
         return all.empty() ? 2 : 0;
@@ -519,6 +523,7 @@ int dispatch(int argc, char** argv) {
         return 0;
     }
     std::string cmd = all[0];
+    if (cmd == "watch") return cmd_watch(std::vector<std::string>(all.begin() + 1, all.end()), run_command);
     Args a(std::vector<std::string>(all.begin() + 1, all.end()));
     if (a.flag("--help") || a.flag("-h")) {
         write_stdout(command_usage(cmd));
@@ -532,20 +537,16 @@ int dispatch(int argc, char** argv) {
     if (cmd == "glsl") return cmd_glsl(a);
     if (cmd == "bench") return cmd_bench(a);
     if (cmd == "mesh") return cmd_mesh(a);
-    std::vector<std::string> cmds{"render", "glsl", "compile", "check", "eval", "slice", "bench", "mesh"};
+    std::vector<std::string> cmds{"render", "glsl", "compile", "check", "eval", "slice", "bench", "mesh", "watch"};
     std::string near = nearest_name(cmd, cmds);
     throw UsageError(near.empty() ? fmt::format("unknown command '{}' (see sdfc --help)", cmd)
                                   : fmt::format("unknown command '{}' (did you mean `{}`?)", cmd, near));
 }
 
-}  // namespace
-}  // namespace sdfc::cli
-
-namespace {
-
-int run(int argc, char** argv) {
+// A command, its errors reported as main reports them (sdfc watch runs commands this way).
+int run_command(const std::vector<std::string>& all) {
     try {
-        return sdfc::cli::dispatch(argc, argv);
+        return dispatch(all);
     } catch (const sdfc::CompileError& e) {
         std::string s = e.formatted();
         std::fwrite(s.data(), 1, s.size(), stderr);
@@ -561,6 +562,13 @@ int run(int argc, char** argv) {
         return 1;
     }
 }
+
+}  // namespace
+}  // namespace sdfc::cli
+
+namespace {
+
+int run(int argc, char** argv) { return sdfc::cli::run_command(std::vector<std::string>(argv + 1, argv + argc)); }
 
 // Whatever a command printed must have reached standard output (a full disk, a closed
 // pipe end): flushed and checked here, and closed and checked at exit.

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <mutex>
 #include <optional>
 
 #include <algorithm>
@@ -115,7 +116,24 @@ const SourceFile& SourceManager::add(std::string path, std::string text) {
     return *files_.back();
 }
 
+namespace {
+std::mutex g_loaded_mutex;
+std::vector<std::string> g_loaded;
+void note_loaded(const std::string& path) {
+    std::lock_guard<std::mutex> lock(g_loaded_mutex);
+    g_loaded.push_back(path);
+}
+}  // namespace
+
+std::vector<std::string> take_loaded_paths() {
+    std::lock_guard<std::mutex> lock(g_loaded_mutex);
+    std::vector<std::string> out;
+    out.swap(g_loaded);
+    return out;
+}
+
 const SourceFile& SourceManager::load(const std::string& path, Loc from, size_t max_bytes) {
+    note_loaded(path);
     // Only regular files: opening a FIFO would block, a device may never end.
     std::error_code ec;
     auto st = std::filesystem::status(path, ec);
@@ -153,6 +171,7 @@ const SourceFile& SourceManager::load(const std::string& path, Loc from, size_t 
 }
 
 const SourceFile& SourceManager::load_stdin(size_t max_bytes) {
+    note_loaded("-");
     static std::optional<std::string> cached;
     if (!cached) {
         std::string text;

@@ -60,6 +60,10 @@ private:
 void check_source_text(const SourceFile& f);
 
 // Owns every loaded file so Locs stay valid for the whole compilation.
+// Every path SourceManager::load or load_stdin was asked for (by any manager) since the
+// last call: the files `sdfc watch` watches (a scene and all it imports).
+std::vector<std::string> take_loaded_paths();
+
 class SourceManager {
 public:
     // Reads a file; throws CompileError at `from` (the import or command line) on failure,
