@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <thread>
 
 #include <fmt/format.h>
@@ -68,10 +69,15 @@ int thread_count(const std::string& v) {
     return hw > 0 ? std::min<int>(n, int(hw)) : n;
 }
 
-void progress_line(const std::string& target, double frac, double elapsed_s, double eta) {
+double progress_after_s() {
+    const char* v = std::getenv("SDFC_PROGRESS_AFTER");
+    return v && *v ? std::atof(v) : 1.0;
+}
+
+void progress_line(const std::string& target, double frac, double elapsed_s, double eta, const std::string& label) {
     const int width = 30, fill = std::clamp(int(frac * width), 0, width);
-    std::fprintf(stderr, "\r\033[Ksdfc: %s [%s%s] %3d%%  %.1f s", target.c_str(), std::string(size_t(fill), '#').c_str(),
-                 std::string(size_t(width - fill), '.').c_str(), int(frac * 100.0), elapsed_s);
+    std::fprintf(stderr, "\r\033[Ksdfc: %s [%s%s] %3d%%%s%s  %.1f s", target.c_str(), std::string(size_t(fill), '#').c_str(),
+                 std::string(size_t(width - fill), '.').c_str(), int(frac * 100.0), label.empty() ? "" : " ", label.c_str(), elapsed_s);
     if (eta >= 0.0) std::fprintf(stderr, ", ETA %.1f s", eta);
 }
 

@@ -27,7 +27,10 @@ CompiledScene build(SourceManager& sm, const std::string& path, Common& c, std::
 // --threads, capped at the machine's hardware threads.
 int thread_count(const std::string& v);
 // One progress bar line on standard error, redrawn in place; eta < 0: none.
-void progress_line(const std::string& target, double frac, double elapsed_s, double eta);
+// Seconds of work before a progress bar shows (1; SDFC_PROGRESS_AFTER sets it, for tests).
+double progress_after_s();
+// `label` ("frame 3/24") goes after the percentage.
+void progress_line(const std::string& target, double frac, double elapsed_s, double eta, const std::string& label = "");
 
 int cmd_mesh(Args& a);
 // `sdfc watch` (watch_command.cpp): `run` runs one command line, its errors reported.

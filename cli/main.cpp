@@ -271,6 +271,12 @@ int cmd_render(Args& a) {
                 SourceManager sm;
                 (void)compile_frame(sm, path, f);
             }
+    // One bar for the whole batch (frames of several scenes): "frame 3/24", the ETA of all.
+    const int total = int(scenes.size()) * (f1 - f0 + 1);
+    const auto batch_t0 = std::chrono::steady_clock::now();
+    int done = 0;
+    bool bar = false;  // drawn: cleared before the next summary line
+    const bool tty = !quiet && isatty(fileno(stderr));
     for (const std::string& path : scenes) {
         std::string name = std::filesystem::path(path).stem().string();
         for (int f = f0; f <= f1; ++f) {
@@ -280,25 +286,36 @@ int cmd_render(Args& a) {
             check_not_input(target, sm);
             if (!is_exr(target) && target != "-")
                 for (const std::string& av : ro.aovs) check_not_input(aov_side_path(target, av), sm);
-            // A progress bar with ETA on a terminal, for renders past a second; the summary
-            // line below either way (unless --quiet).
-            bool bar = false;
-            if (!quiet && isatty(fileno(stderr))) {
+            // A progress bar with ETA on a terminal, for renders (or batches) past a second;
+            // the summary line below either way (unless --quiet).
+            const std::string shown = total > 1 ? *out : target;
+            const std::string label = total > 1 ? fmt::format("frame {}/{}", done + 1, total) : "";
+            if (tty) {
                 ro.progress = [&](const RenderProgress& p) {
-                    if (p.tiles_done >= p.tiles_total || p.elapsed_s < 1.0 || p.tiles_total <= 0) return;
-                    const double frac = double(p.tiles_done) / double(p.tiles_total);
-                    progress_line(target, frac, p.elapsed_s, frac > 0 ? p.elapsed_s * (1.0 - frac) / frac : 0.0);
+                    if (p.tiles_total <= 0 || p.tiles_done >= p.tiles_total) return;
+                    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - batch_t0).count();
+                    if (elapsed < progress_after_s()) return;
+                    const double frac = (done + double(p.tiles_done) / double(p.tiles_total)) / total;
+                    progress_line(shown, frac, elapsed, frac > 0 ? elapsed * (1.0 - frac) / frac : 0.0, label);
                     bar = true;
                 };
             }
             auto t0 = std::chrono::steady_clock::now();
             Image img = cs.is_2d ? render_2d(cs, cs.render.width, cs.render.height, ro.threads, baseline) : render(cs, ro);
             double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-            if (bar) std::fputs("\r\033[K", stderr);
+            if (bar) std::fputs("\r\033[K", stderr), bar = false;
             write_image(target, img, WriteOptions{true, fmt_ext});
+            ++done;
             if (!quiet)
                 std::fprintf(stderr, "sdfc: wrote %s (%dx%d, %.1f ms)\n", target == "-" ? "standard output" : target.c_str(), img.width,
                              img.height, ms);
+            // Between the frames of a batch too (a frame may take under the bar's 0.1 s).
+            const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - batch_t0).count();
+            if (tty && total > 1 && done < total && elapsed >= progress_after_s()) {
+                const double frac = double(done) / total;
+                progress_line(*out, frac, elapsed, elapsed * (1.0 - frac) / frac, fmt::format("frame {}/{}", done + 1, total));
+                bar = true;
+            }
         }
     }
     return 0;

@@ -143,7 +143,7 @@ int cmd_mesh(Args& a) {
     if (!quiet && isatty(fileno(stderr))) {
         mo.progress = [&](double frac) {
             const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-            if (s < 1.0) return;
+            if (s < progress_after_s()) return;
             progress_line(*out, frac, s, -1.0);
             bar = true;
         };

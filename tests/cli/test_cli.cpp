@@ -11,7 +11,7 @@ using namespace sdfc;
 using test::run_sdfc;
 namespace fs = std::filesystem;
 
-TEST_CASE("--help and --version") {
+TEST_CASE("the flags --help and --version") {
     auto h = run_sdfc("--help");
     CHECK(h.status == 0);
     CHECK(h.out.find("sdfc render SCENE") != std::string::npos);

@@ -16,7 +16,7 @@ const char* kScript =
     "for (i = [0 : n - 1]) translate([i * 3, 0, 0]) material(color = tint) sphere(size);\n";
 }  // namespace
 
-TEST_CASE("-D sets a top-level let for every command") {
+TEST_CASE("the flag -D sets a top-level let for every command") {
     const std::string s = test::write_temp("defines.sdf", kScript);
     CHECK(run_sdfc("eval " + q(s) + " --at 0,0,0").out == "-1\n");
     CHECK(run_sdfc("eval " + q(s) + " --at 0,0,0 -D size=2").out == "-2\n");
@@ -31,7 +31,7 @@ TEST_CASE("-D sets a top-level let for every command") {
     CHECK(run_sdfc("check " + q(s) + " -D size=0.5").status == 0);
 }
 
-TEST_CASE("-D errors are command-line errors, with did-you-mean") {
+TEST_CASE("the flag -D: its errors are command-line errors, with did-you-mean") {
     const std::string s = test::write_temp("defines_bad.sdf", kScript);
     auto unknown = run_sdfc("check " + q(s) + " -D sise=2");
     CHECK(unknown.status == 2);

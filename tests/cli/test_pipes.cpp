@@ -16,7 +16,7 @@ std::string q(const std::string& s) { return "'" + s + "'"; }
 std::string stdin_file(const std::string& name, const std::string& text) { return test::write_temp(name, text); }
 }  // namespace
 
-TEST_CASE("- reads the scene from standard input") {
+TEST_CASE("the scene path - reads the scene from standard input") {
     const std::string in = stdin_file("pipe_in.sdf", "sphere(1);\n");
     CHECK(run_sdfc("eval - --at 2,0,0", "", in).out == "1\n");
     CHECK(run_sdfc("check -", "", in).status == 0);
@@ -36,7 +36,7 @@ TEST_CASE("- reads the scene from standard input") {
     CHECK(fs::exists(test::temp_dir() + "/pipe_f1.png"));
 }
 
-TEST_CASE("-o - writes images, meshes and shaders to standard output") {
+TEST_CASE("the output path - writes images, meshes and shaders to standard output") {
     const std::string s = test::write_temp("pipe_out.sdf", "sphere(1);\n");
     auto png = run_sdfc("render " + q(s) + " -o - --format png --width 16 --height 8");
     REQUIRE(png.status == 0);
@@ -58,7 +58,7 @@ TEST_CASE("-o - writes images, meshes and shaders to standard output") {
     CHECK_FALSE(fs::exists("-"));
 }
 
-TEST_CASE("-o - needs a format, and --format needs -o -") {
+TEST_CASE("the output path - needs a format, and --format needs it") {
     const std::string s = test::write_temp("pipe_err.sdf", "sphere(1);\n");
     CHECK(run_sdfc("render " + q(s) + " -o -").err == "sdfc: error: -o - (standard output) needs --format (png, jpg, exr, hdr, tif, ...)\n");
     CHECK(run_sdfc("render " + q(s) + " -o x.png --format png").err ==
