@@ -264,7 +264,7 @@ Value Interp::call_value(const Value& callee, const std::vector<ast::Arg>& args,
     fail(loc, fmt::format("{} cannot be called", describe(callee)));
 }
 
-Value Interp::call_user(const Callable& fn, const std::vector<ast::Arg>& args, Env* env, Loc loc) {
+Value Interp::call_user(const Callable& fn, const std::vector<ast::Arg>& args, Env* env, Loc loc, const Value* last) {
     const ast::Stmt& def = *fn.def;
     std::vector<const ast::Expr*> given(def.params.size(), nullptr);
     std::vector<Value> values(def.params.size());
@@ -306,7 +306,9 @@ Value Interp::call_user(const Callable& fn, const std::vector<ast::Arg>& args, E
     callenv->field_scope = env->field_scope;
     for (size_t i = 0; i < def.params.size(); ++i) {
         const ast::Param& p = def.params[i];
-        if (!given[i]) {
+        if (!given[i] && last && i + 1 == def.params.size()) {
+            values[i] = *last;  // the shape a user modifier is written before
+        } else if (!given[i]) {
             if (!p.default_value) fail(loc, fmt::format("missing argument '{}' of {}", p.name, fn.name));
             values[i] = eval(*p.default_value, callenv);
         }
@@ -317,8 +319,36 @@ Value Interp::call_user(const Callable& fn, const std::vector<ast::Arg>& args, E
     return r;
 }
 
+// Whether a call of `fn` with `args` leaves its last parameter, one without a default, to
+// the shape written after it (a user modifier: `def at(v, s) = translate(v) s;`, `at([1, 0,
+// 0]) sphere(1);`, as OpenSCAD's modules take children()).
+bool leaves_last_to_target(const Callable& fn, const std::vector<ast::Arg>& args) {
+    const ast::Stmt& def = *fn.def;
+    if (def.params.empty() || def.params.back().default_value) return false;
+    size_t positional = 0;
+    for (const auto& a : args) {
+        if (a.name.empty()) ++positional;
+        else if (a.name == def.params.back().name) return false;
+    }
+    return positional < def.params.size();
+}
+
 Value Interp::apply(const ast::Expr& e, Env* env) {
-    Value m = eval(*e.lhs, env);
+    Value m;
+    if (e.lhs->kind == ast::ExprKind::Call) {
+        const Value callee = eval(*e.lhs->callee, env);
+        if (callee.t == VT::Function && !callee.fn->builtin && callee.fn->def && leaves_last_to_target(*callee.fn, e.lhs->args)) {
+            const Value t = eval(*e.rhs, env);
+            const Value target = Value::of_shape(to_shape(t, e.rhs->loc, fmt::format("the target of {}", callee.fn->name).c_str()));
+            Value r = call_user(*callee.fn, e.lhs->args, env, e.lhs->loc, &target);
+            if (r.t != VT::Shape)
+                fail(e.lhs->loc, fmt::format("{} is written before a shape, so it must return a shape, but it returns {}", callee.fn->name, describe(r)));
+            return r;
+        }
+        m = call_value(callee, e.lhs->args, env, e.lhs->loc);
+    } else {
+        m = eval(*e.lhs, env);
+    }
     if (m.t == VT::Function && m.fn->builtin) {
         const BuiltinInfo& bi = builtin_info(m.fn->id);
         if (bi.kind == BuiltinKind::Modifier || bi.kind == BuiltinKind::MaterialCtor)

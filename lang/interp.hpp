@@ -97,7 +97,8 @@ public:
     [[noreturn]] void bad_statement(const ast::Stmt& s, const Value& v);  // neither a shape nor a setting
     void exec_stmts(const std::vector<ast::StmtPtr>& stmts, Env* env, std::vector<ShapePtr>& out);
     Value call_value(const Value& callee, const std::vector<ast::Arg>& args, Env* env, Loc loc);
-    Value call_user(const Callable& fn, const std::vector<ast::Arg>& args, Env* env, Loc loc);
+    // `last`: the value of the last parameter when no argument gives it (a user modifier's target).
+    Value call_user(const Callable& fn, const std::vector<ast::Arg>& args, Env* env, Loc loc, const Value* last = nullptr);
     Value apply(const ast::Expr& e, Env* env);
     // Runs body once per combination of the bindings (the first varies slowest), each in a
     // fresh scope; enforces the loop limits.

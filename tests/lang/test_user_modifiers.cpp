@@ -1,0 +1,33 @@
+// User modifiers (issue 16, item 1): a def whose last parameter, without a default, is left
+// to the shape written after the call, as OpenSCAD's modules take children().
+#include <catch2/catch.hpp>
+
+#include "support.hpp"
+
+using namespace sdfc;
+using namespace sdfc::test;
+
+TEST_CASE("a def written before a shape or a block takes it as its last argument", "[lang]") {
+    const std::string defs = "def at(i, j, s) = translate([i * 3, 0, j * 3]) s;\n"
+                             "def twice(s) = union { s; translate([0, 2, 0]) s; };\n";
+    // Before an operation with a block.
+    CHECK(dist_of(defs + "at(2, 2) intersection { sphere(1.2); box(2); }", 6, 0, 6) == Approx(-1.0f));
+    // Before a block of statements (their union).
+    CHECK(dist_of(defs + "at(0, 1) { sphere(0.5); box(0.2); }", 0, 0, 3) == Approx(-0.5f));
+    // Chained with other modifiers, the arguments named or not.
+    const std::string chain = defs + "twice() at(1, 0) sphere(0.3);";
+    CHECK(dist_of(chain, 3, 0, 0) == Approx(-0.3f));
+    CHECK(dist_of(chain, 3, 2, 0) == Approx(-0.3f));
+    CHECK(dist_of(defs + "at(j = 1, i = 0) sphere(1);", 0, 0, 3) == Approx(-1.0f));
+    // Called with every argument, it is a plain function.
+    CHECK(dist_of(defs + "at(1, 0, sphere(1));", 3, 0, 0) == Approx(-1.0f));
+}
+
+TEST_CASE("a user modifier's errors name it", "[lang]") {
+    CHECK(first_error_line("def f(x) = x * 2;\nf(1) sphere(1);") ==
+          "test.sdf:2:1: error: a number is written before a shape but is not an operation");
+    CHECK(first_error_line("def g(a, s) = a + 1;\ng(1) sphere(1);") ==
+          "test.sdf:2:1: error: g is written before a shape, so it must return a shape, but it returns a number");
+    CHECK(first_error_line("def at(v, s) = translate(v) s;\nlet k = 3;\nat([1, 0, 0]) k;") ==
+          "test.sdf:3:15: error: the target of at must be a shape, not a number");
+}
