@@ -24,6 +24,9 @@ Common read_common(Args& a);
 std::string one_scene(Args& a, const char* cmd);
 // Loads and compiles a scene at `time`, its distance checked finite.
 CompiledScene build(SourceManager& sm, const std::string& path, Common& c, std::optional<float> time);
+// "" or why the picture will show nothing of the scene: the camera inside the solid, or
+// the scene's bounds wholly outside the view (render warns).
+std::string view_problem(const CompiledScene& cs);
 // --threads, capped at the machine's hardware threads.
 int thread_count(const std::string& v);
 // One progress bar line on standard error, redrawn in place; eta < 0: none.

@@ -142,6 +142,7 @@ void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
         if (auto v = a.value(flag)) {
             *field = Args::to_float(flag, *v);
             if (!(*field > 0.0f)) throw UsageError(fmt::format("{} must be above 0, not {}", flag, *v));
+            if (field == &cs.render.max_distance) cs.render.max_distance_set = true;
         }
     for (auto [flag, field] : {std::pair{"--shadows", &cs.render.shadows}, std::pair{"--ao", &cs.render.ao}})
         if (auto v = a.value(flag)) {
@@ -300,6 +301,8 @@ int cmd_render(Args& a) {
                     bar = true;
                 };
             }
+            if (!quiet && f == f0)  // once per scene
+                if (const std::string why = view_problem(cs); !why.empty()) std::fprintf(stderr, "sdfc: warning: %s\n", why.c_str());
             auto t0 = std::chrono::steady_clock::now();
             Image img = cs.is_2d ? render_2d(cs, cs.render.width, cs.render.height, ro.threads, baseline) : render(cs, ro);
             double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -414,6 +414,7 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
             r.samples = whole(2, 1, 1024);
             r.max_steps = whole(3, 1, 100000);
             r.max_distance = const_num(Value::number(b.size(4, true)), b.loc(4), "max_distance");
+            r.max_distance_set = b.has(4);
             r.epsilon = const_num(Value::number(b.size(5, true)), b.loc(5), "epsilon");
             r.shadows = const_num(Value::number(b.boolean(6)), b.loc(6), "shadows") != 0;
             r.ao = const_num(Value::number(b.boolean(7)), b.loc(7), "ao") != 0;

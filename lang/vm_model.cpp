@@ -128,6 +128,7 @@ Scene load_vm(SourceManager&, const SourceFile& file) {
     s.render.width = 1024;
     s.render.height = 1024;
     s.render.max_distance = 20.0f;
+    s.render.max_distance_set = true;
     return s;
 }
 

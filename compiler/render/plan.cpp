@@ -83,6 +83,30 @@ std::vector<ResolvedLight> default_lights(const ResolvedCamera& camera) {
     return {key, fill};
 }
 
+// The far limit when the script sets none: at least the default, far enough for the whole
+// scene (its bounds' farthest corner from the camera; with floors, four times the rest's)
+// and for four times the camera's distance to its target, so a scene in millimetres works
+// as one in metres.
+static float fitted_max_distance(const PlanInputs& in, float base) {
+    if (!in.camera_position) return base;
+    const glm::vec3 cam = *in.camera_position;
+    float far = base;
+    if (in.camera_target) far = std::max(far, 4.0f * glm::length(*in.camera_target - cam));
+    auto farthest = [&](const Bounds& b) {
+        float d = 0.0f;
+        for (int k = 0; k < 8; ++k) {
+            const glm::vec3 c((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z);
+            d = std::max(d, glm::length(c - cam));
+        }
+        return d;
+    };
+    const Bounds& b = in.bounds.bounds;
+    const Bounds& sb = in.bounds.solid_bounds;
+    if (b.finite() && b.lo.x <= b.hi.x) far = std::max(far, 1.01f * farthest(b));
+    else if (sb.finite() && sb.lo.x <= sb.hi.x) far = std::max(far, 4.0f * farthest(sb));
+    return std::isfinite(far) ? std::min(far, 1e15f) : base;
+}
+
 RenderPlan resolve_plan(const PlanInputs& in) {
     RenderPlan p;
     const RenderSettings& rs = in.settings;
@@ -98,6 +122,7 @@ RenderPlan resolve_plan(const PlanInputs& in) {
     p.max_bounces = std::clamp(rs.max_bounces, 0, 64);
     p.eps = std::isfinite(rs.epsilon) && rs.epsilon > 0 ? rs.epsilon : 1e-4f;
     p.max_dist = std::isfinite(rs.max_distance) && rs.max_distance > 0 ? rs.max_distance : 100.0f;
+    if (!rs.max_distance_set) p.max_dist = fitted_max_distance(in, p.max_dist);
     p.shadows = rs.shadows;
     p.ao = rs.ao && !p.raw;
 

@@ -129,6 +129,7 @@ struct RenderSettings {
     Loc loc;
     int width = 640, height = 480, samples = 1, max_steps = 256, max_bounces = 3;
     float max_distance = 100.0f, epsilon = 1e-4f;
+    bool max_distance_set = false;  // by the script or a flag: else the plan fits it to the scene
     bool shadows = true, ao = true;
     std::string aa = "grid";  // "grid" (stratified supersampling) or "cone"
 };

@@ -73,3 +73,19 @@ TEST_CASE("every render(...) setting has a flag") {
           "sdfc: error: --max-steps must be from 1 to 100000, not 0\n");
     CHECK(run_sdfc("bench " + q(scene) + " --width 8 --height 8 --repeat 1 --ao off").status == 0);
 }
+
+TEST_CASE("render warns when the camera is inside the solid or looks away from the scene") {
+    const std::string in = test::write_temp("view_inside.sdf", "camera(position = [0, 0, 0.5]); sphere(1);\n");
+    const std::string out = test::temp_dir() + "/view.png";
+    auto inside = run_sdfc("render " + q(in) + " -o " + q(out) + " --width 8 --height 8");
+    CHECK(inside.status == 0);
+    CHECK(inside.err.rfind("sdfc: warning: the camera (at 0, 0, 0.5) is inside the scene's solid: the picture shows it from within\n", 0) == 0);
+    const std::string away = test::write_temp("view_away.sdf", "camera(position = [0, 0, 5], target = [0, 0, 10]); sphere(1);\n");
+    CHECK(run_sdfc("render " + q(away) + " -o " + q(out) + " --width 8 --height 8").err.rfind(
+              "sdfc: warning: nothing of the scene is in view: the camera at 0, 0, 5 looks at 0, 0, 10, away from the scene's bounds [-1, -1, -1] .. [1, "
+              "1, 1]\n",
+              0) == 0);
+    const std::string fine = test::write_temp("view_fine.sdf", "camera(position = [0, 0, 150]); sphere(20);\n");
+    CHECK(run_sdfc("render " + q(fine) + " -o " + q(out) + " --width 8 --height 8").err.find("warning") == std::string::npos);
+    CHECK(run_sdfc("render " + q(in) + " -o " + q(out) + " --width 8 --height 8 -q").err.empty());
+}
