@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "compiler/scene/lower.hpp"
+#include "lang/css_colors.hpp"
 #include "lang/interp.hpp"
 
 namespace sdfc {
@@ -53,7 +54,7 @@ std::vector<BuiltinInfo> make_table() {
         }
     }
     add(B::MaterialFn, "material", K::MaterialCtor, std::move(mat));
-    add(B::Color, "color", K::MaterialCtor, {req("color", P::Vec)});  // named like material's and ambient's
+    add(B::Color, "color", K::MaterialCtor, {req("color", P::Any)});  // [r, g, b] or a CSS name; named like material's
     // Settings
     add(B::Camera, "camera", K::Setting,
         {opt("position", P::Vec3, 0, 0, 5), opt("target", P::Vec3, 0, 0, 0), opt("up", P::Vec3, 0, 1, 0), opt("fov", P::Num, 45),
@@ -331,8 +332,25 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
             mat = default_material(gr);
             if (b.has(0)) {
                 const Value& c = b.val(0);
-                if (c.n < 3) fail(b.loc(0), "color takes [r, g, b]");
-                for (int k = 0; k < 3; ++k) mat[kMatR + k] = c.c[k];
+                if (c.t == VT::String) {
+                    // A CSS name or #rrggbb: sRGB, made linear like every colour of a scene.
+                    const auto rgb = css_color(*c.str);
+                    if (!rgb) {
+                        std::vector<std::string> names;
+                        for (const CssColor& k : kCssColors) names.push_back(k.name);
+                        const std::string near = nearest_name(*c.str, names);
+                        fail(b.loc(0), near.empty() ? fmt::format("unknown colour \"{}\" (a CSS name such as \"tomato\", or \"#rrggbb\")", *c.str)
+                                                    : fmt::format("unknown colour \"{}\" (did you mean \"{}\"?)", *c.str, near));
+                    }
+                    for (int k = 0; k < 3; ++k) {
+                        const float v = float((*rgb >> (16 - 8 * k)) & 0xFF) / 255.0f;
+                        mat[kMatR + k] = gr.constant(v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f));
+                    }
+                } else {
+                    if (c.t != VT::Vector || c.n < 3)
+                        fail(b.loc(0), fmt::format("color takes [r, g, b] or a colour name such as \"tomato\", not {}", describe(c)));
+                    for (int k = 0; k < 3; ++k) mat[kMatR + k] = c.c[k];
+                }
             } else {
                 // `color` with no argument only makes sense applied; use the default.
             }
