@@ -241,7 +241,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
             if (++k < 4) continue;
             k = 0;
             vec3 N = sdf_normal(g, Dr);
-            Nf = dot(Dr, N) > 0.0 ? -N : N;  // facing the incoming ray
+            Nf = sdf_facing_normal(N, Dr, r.inside);
             m = sdf_surface(P);
             bool can_spawn = r.gen < SDF_MAX_BOUNCES;
             float bias = sdf_bias(SDF_EPSILON, P, path);

@@ -247,6 +247,18 @@ SDF_FN vec3 sdf_normal(vec3 g, vec3 dir) {
     return (len2 > 1e-30f && sdf_finite(len2)) ? g * (1.0f / sqrt(len2)) : -dir;
 }
 
+// The normal a hit is shaded with, facing the incoming ray d. A ray inside a solid meets
+// its surface from within: the outward normal, flipped. From outside, an estimate facing
+// away (at a silhouette's edge the tetrahedron blends in a face the ray cannot see) is bent
+// edge-on, a little towards the ray, not flipped: flipped it would point into the solid,
+// where the occlusion taps and the lights find nothing (black pixels along edges).
+SDF_FN vec3 sdf_facing_normal(vec3 n, vec3 d, bool inside) {
+    float dn = dot(d, n);
+    if (!(dn > 0.0f)) return n;
+    if (inside) return -n;
+    return normalize(n - d * (dn + 0.05f));
+}
+
 // Material channels made safe to shade with (no NaN/inf, sensible ranges): colours,
 // specular and emission >= 0, reflectance and transparency in [0, 1], and these two.
 SDF_FN float sdf_safe_shininess(float v) { return sdf_finite(v) ? clamp(v, 0.0f, 1e4f) : 32.0f; }

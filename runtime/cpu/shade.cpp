@@ -121,7 +121,7 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
     for (size_t i = 0; i < n; ++i) {
         const glm::vec3 P = h.o(i), D = h.d(i), W = h.w(i);
         const glm::vec3 N(nx_[i], ny_[i], nz_[i]);
-        const glm::vec3 Nf = glm::dot(D, N) > 0.0f ? -N : N;  // facing the incoming ray
+        const glm::vec3 Nf = sdf_facing_normal(N, D, h.inside[i]);
         const float* m = &mat_[i * kMatOut];
         const float ior = m[kMatIor];
         const float bias = f_.bias(P, h.t0[i]);

@@ -39,3 +39,43 @@ TEST_CASE("scale: a millimetre scene with default settings is not empty", "[rend
     // The script's own limit is kept: this one stops short of the sphere.
     CHECK(centre_red("camera(position = [0, 0, 150]); render(max_distance = 100); material(color = [1, 0, 0]) sphere(20);") == 0.0f);
 }
+
+namespace {
+
+// Surface pixels (a hit: depth under the far limit) that came out pure black.
+int black_surface_pixels(const std::string& src, int w, int h) {
+    auto c = compile_text(src);
+    c->cs.render.width = w, c->cs.render.height = h;
+    RenderOptions ro;
+    ro.aovs = {"depth"};
+    const Image img = render(c->cs, ro);
+    const AovPlane* depth = img.aov("depth");
+    REQUIRE(depth);
+    const float far = plan_of(c->cs).max_dist;
+    int black = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * size_t(w) + size_t(x);
+            if (!(depth->data[i] < 0.999f * far)) continue;
+            black += img.at(x, y, 0) <= 0.0f && img.at(x, y, 1) <= 0.0f && img.at(x, y, 2) <= 0.0f;
+        }
+    return black;
+}
+
+}  // namespace
+
+TEST_CASE("shading: no lit surface pixel is black (ambient occlusion at edges)", "[render]") {
+    const std::string box = "camera(position = [3, 2.5, 4], target = [0, 0, 0]); background([0.5, 0.5, 0.5]); box([2, 0.5, 2]);";
+    CHECK(black_surface_pixels(box, 640, 360) == 0);
+    CHECK(black_surface_pixels("render(epsilon = 1e-3);" + box, 640, 360) == 0);
+}
+
+TEST_CASE("shading: no black pixels on a Menger field or a displaced plane at grazing angles", "[render]") {
+    CHECK(black_surface_pixels(
+              "camera(position = [3, 2, 4], target = [0, 0, 0]);\n"
+              "def menger_cut(p, s) = { let a = mod(p * s, 2) - 1; let r = abs(1 - 3 * abs(a));\n"
+              "  (min(max(r.x, r.y), min(max(r.y, r.z), max(r.z, r.x))) - 1) / (s * 3) };\n"
+              "field (p) -> max(box(2)(p), max(menger_cut(p, 1), menger_cut(p, 3)));",
+              320, 180) == 0);
+    CHECK(black_surface_pixels("camera(position = [0, 0.4, 6], target = [0, 0, -10]); displace(0.05, 4) plane();", 320, 180) == 0);
+}
