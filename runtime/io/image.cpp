@@ -41,6 +41,10 @@ std::vector<fs::path> module_candidates() {
     return {dir / kModule, dir.parent_path() / kModule, dir.parent_path() / "lib" / "sdfc" / kModule};
 }
 
+#ifdef SDFC_IMAGE_BUILTIN
+// Linked in (sanitizer and fuzz builds: CMakeLists.txt says why).
+const ImageBackend& backend() { return *sdfc_image_backend(); }
+#else
 const ImageBackend& backend() {
     static const ImageBackend* loaded = nullptr;
     static std::string failure;
@@ -72,6 +76,7 @@ const ImageBackend& backend() {
     if (!loaded) throw std::runtime_error("cannot load the image library " + std::string(kModule) + ": " + failure);
     return *loaded;
 }
+#endif
 
 }  // namespace
 

@@ -434,7 +434,7 @@ private:
         std::vector<size_t> first(n + 1, 0);
         for (size_t i = 0; i < n; ++i) first[i + 1] = first[i] + count[i];
         std::vector<glm::vec3> pts(first[n]);
-        for (size_t i = 0; i < n; ++i) std::copy_n(&slots[i * kSlot], count[i], &pts[first[i]]);
+        for (size_t i = 0; i < n; ++i) std::copy_n(slots.data() + i * kSlot, count[i], pts.data() + first[i]);
         std::vector<Dual> d(pts.size());
         field_(pts.data(), pts.size(), d.data());
         std::vector<uint8_t> make(n, 0);
