@@ -131,6 +131,15 @@ struct Binder {
                 named = true;
                 auto it = std::find_if(info.params.begin(), info.params.end(), [&](const ParamSpec& p) { return a.name == p.name; });
                 if (it == info.params.end()) {
+                    // OpenSCAD's cylinder arguments: the sdfc forms.
+                    if (std::string_view(info.name) == "cylinder") {
+                        if (a.name == "r1" || a.name == "r2" || a.name == "d1" || a.name == "d2")
+                            in.fail(a.loc, fmt::format("cylinder has no parameter '{}': a cylinder with two radii is a cone, "
+                                                       "cone(h, r1, r2) (OpenSCAD's d1, d2 are twice those)", a.name));
+                        if (a.name == "d") in.fail(a.loc, "cylinder has no parameter 'd': give the radius, r = d / 2");
+                        if (a.name == "center")
+                            in.fail(a.loc, "cylinder has no parameter 'center': it is always centred on the origin, along y");
+                    }
                     std::vector<std::string> names;
                     for (const auto& p : info.params) names.push_back(p.name);
                     std::string near = nearest_name(a.name, names);
