@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <set>
 #include <thread>
 
 #include <fmt/format.h>
@@ -54,10 +55,24 @@ std::string one_scene(Args& a, const char* cmd) {
     return pos[0];
 }
 
+namespace {
+std::set<std::string> g_warned;  // each warning once (a scene compiles once per frame)
+}  // namespace
+
+void print_warnings(const Scene& s) {
+    for (const Diagnostic& w : s.warnings) {
+        const std::string text = format_diagnostic(w, "warning");
+        if (g_warned.insert(text).second) std::fwrite(text.data(), 1, text.size(), stderr);
+    }
+}
+
+void forget_warnings() { g_warned.clear(); }
+
 CompiledScene build(SourceManager& sm, const std::string& path, Common& c, std::optional<float> time) {
     InterpretOptions o = c.interp;
     o.time = time;
     Scene s = load_scene(sm, path, o);
+    print_warnings(s);
     CompiledScene cs = compile_scene(s);
     check_field_finite(s, cs);
     return cs;

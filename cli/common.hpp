@@ -22,6 +22,10 @@ struct Common {
 Common read_common(Args& a);
 // The command's one scene file (a usage error for none or several).
 std::string one_scene(Args& a, const char* cmd);
+// The script's warnings (path:line:col: warning: ...) on standard error.
+void print_warnings(const Scene& s);
+// Warnings already printed are printed again (sdfc watch: a new run).
+void forget_warnings();
 // Loads and compiles a scene at `time`, its distance checked finite.
 CompiledScene build(SourceManager& sm, const std::string& path, Common& c, std::optional<float> time);
 // "" or why the picture will show nothing of the scene: the camera inside the solid, or

@@ -348,6 +348,7 @@ int cmd_compile(Args& a) {
     }
     if (*emit == "ir") {
         Scene s = load_scene(sm, path, c.interp);
+        print_warnings(s);
         LoweredScene ls = lower_scene(*s.graph, s);
         std::vector<NodeId> roots{ls.distance, ls.shading_distance};
         std::vector<std::string> names{"distance", "shading.d"};
@@ -464,6 +465,7 @@ int cmd_glsl(Args& a) {
     InterpretOptions o = c.interp;
     o.time = std::nullopt;  // `time` becomes iTime
     Scene s = load_scene(sm, path, o);
+    print_warnings(s);
     if (out) check_not_input(*out, sm);
     std::string text = emit_glsl(s, t, sample_batch);
     if (!out) {

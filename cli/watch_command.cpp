@@ -116,6 +116,7 @@ int cmd_watch(const std::vector<std::string>& args, int (*run)(const std::vector
     int rc = 0;
     for (long n = 1; runs < 0 || n <= runs; ++n) {
         (void)take_loaded_paths();
+        forget_warnings();
         const auto t0 = std::chrono::steady_clock::now();
         rc = run(command);
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -31,8 +31,8 @@ std::string_view SourceFile::line(uint32_t n) const {
     return std::string_view(text).substr(b, e - b);
 }
 
-std::string format_diagnostic(const Diagnostic& d) {
-    if (!d.loc.known()) return fmt::format("sdfc: error: {}\n", d.message);
+std::string format_diagnostic(const Diagnostic& d, const char* kind) {
+    if (!d.loc.known()) return fmt::format("sdfc: {}: {}\n", kind, d.message);
     const SourceFile& file = *d.loc.file;
     uint32_t line = d.loc.line;
     std::string_view src = file.line(line);
@@ -54,7 +54,7 @@ std::string format_diagnostic(const Diagnostic& d) {
     // Columns count characters (UTF-8 code points), not bytes.
     size_t chars = 0;
     for (size_t i = 0; i < col; ++i) chars += continuation(i) ? 0 : 1;
-    std::string out = fmt::format("{}:{}:{}: error: {}\n", file.path, line, chars + 1, d.message);
+    std::string out = fmt::format("{}:{}:{}: {}: {}\n", file.path, line, chars + 1, kind, d.message);
     // A very long line (minified or generated text) is shown as a window around the column.
     constexpr size_t kWindow = 160;
     size_t b = 0, e = src.size();

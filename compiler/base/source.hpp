@@ -38,7 +38,7 @@ struct Diagnostic {
 };
 
 // `path:line:col: error: message`, the source line, a caret under the column.
-std::string format_diagnostic(const Diagnostic& d);
+std::string format_diagnostic(const Diagnostic& d, const char* kind = "error");  // or "warning"
 
 // Thrown by any stage for errors the user caused. Holds one or more diagnostics.
 class CompileError : public std::runtime_error {

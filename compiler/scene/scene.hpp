@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "compiler/base/source.hpp"
 #include "compiler/ir/ir.hpp"
 
 namespace sdfc {
@@ -145,6 +146,9 @@ struct Scene {
     bool raw_field = false;  // a .vm model: root is a Field, no Lipschitz claim
     float time = 0.0f;       // the time the scene was built at (when not symbolic)
     std::shared_ptr<void> keepalive;  // what field closures need (the interpreter's state)
+    // What the script does that is legal but likely not meant (an intersection of one
+    // shape, an empty difference, an alpha that is ignored): the commands print them.
+    std::vector<Diagnostic> warnings;
 };
 
 // Sets the settings of LANGUAGE.md section 8's defaults (camera at [0, 0, 5] looking at
