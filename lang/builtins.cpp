@@ -164,6 +164,7 @@ struct Binder {
             case PT::Num: if (v.t != VT::Number) bad("a number"); break;
             case PT::Vec3: if (!(v.t == VT::Vector && v.n == 3)) bad("a 3-component vector"); break;
             case PT::NumOrVec3: if (!(v.t == VT::Number || (v.t == VT::Vector && v.n == 3))) bad("a number or a 3-component vector"); break;
+            case PT::NumOrVec2: if (!(v.t == VT::Number || (v.t == VT::Vector && v.n == 2))) bad("a number or a 2-component vector"); break;
             case PT::Vec: if (v.t != VT::Vector) bad("a vector"); break;
             case PT::Bool: if (v.t != VT::Bool && v.t != VT::Number) bad("true or false"); break;
             case PT::String: if (v.t != VT::String) bad("a string"); break;
@@ -189,6 +190,16 @@ struct Binder {
         require(i);
         const auto& d = info.params[i].def;
         return {in.g->constant(d[0]), in.g->constant(d[1]), in.g->constant(d[2])};
+    }
+    Vec3N vec2(size_t i) {  // [x, y] or a number for both; the third slot unused
+        if (has(i)) {
+            const Value& v = val(i);
+            if (v.t == VT::Number) return {v.c[0], v.c[0], kNoNode};
+            return {v.c[0], v.c[1], kNoNode};
+        }
+        require(i);
+        const auto& d = info.params[i].def;
+        return {in.g->constant(d[0]), in.g->constant(d[1]), kNoNode};
     }
     NodeId boolean(size_t i) {
         if (has(i)) return in.truth(val(i), loc(i));
@@ -247,6 +258,7 @@ struct Binder {
             if (p.type == PT::Num) v[0] = num(i);
             else if (p.type == PT::Bool) v[0] = boolean(i);
             else if (p.type == PT::Vec3 || p.type == PT::NumOrVec3) v = vec3(i), n = 3;
+            else if (p.type == PT::NumOrVec2) v = vec2(i), n = 2;
             else in.fail(out.call_loc, fmt::format("internal: {} stores a parameter of no shape type", info.name));
             for (int k = 0; k < n; ++k) {
                 if (p.checks & Finite) finite(v[k], i);

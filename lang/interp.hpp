@@ -48,7 +48,7 @@ enum class Builtin : uint16_t {
 enum class BuiltinKind { Math, Shape, Modifier, Setting, MaterialCtor };
 
 // Parameter types of builtins.
-enum class PT { Num, Vec3, NumOrVec3, Vec, Bool, String, Material, Any };
+enum class PT { Num, Vec3, NumOrVec3, NumOrVec2, Vec, Bool, String, Material, Any };
 
 // The checks of a shape's constant arguments (the Checks column of shapes.def).
 namespace param_check {

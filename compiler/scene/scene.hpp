@@ -61,6 +61,7 @@ size_t shape_slots(ShapeKind k);  // the size of Shape::params
 #define SDFC_SLOTS_Bool(n) n,
 #define SDFC_SLOTS_Vec3(n) n, n##_y_, n##_z_,
 #define SDFC_SLOTS_NumOrVec3(n) n, n##_y_, n##_z_,
+#define SDFC_SLOTS_NumOrVec2(n) n, n##_y_,
 #define SDFC_SLOTS_Mat3(n) n, n##_01_, n##_02_, n##_10_, n##_11_, n##_12_, n##_20_, n##_21_, n##_22_,
 #define SDFC_P(name, type, ...) SDFC_SLOTS_##type(name)
 #define SDFC_ARG(...)
@@ -77,6 +78,7 @@ size_t shape_slots(ShapeKind k);  // the size of Shape::params
 #undef SDFC_SLOTS_Bool
 #undef SDFC_SLOTS_Vec3
 #undef SDFC_SLOTS_NumOrVec3
+#undef SDFC_SLOTS_NumOrVec2
 #undef SDFC_SLOTS_Mat3
 
 // Axis-aligned bounds of the scene's surface (infinite components for unbounded scenes).

@@ -332,6 +332,37 @@ Lowered lower_Onion(L& l, const Shape& s, const Vec3N& p, const MaterialN* inher
 }
 Bounds bounds_Onion(const BoundsIn& b) { return grow(b.child(), b.f(OnionP::thickness)); }
 
+// The child's cross-section at z = 0, d2, extruded: max-combined exactly with |z| - h/2
+// (the 2D box formula of (d2, |z| - h/2)).
+Lowered lower_Extrude(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    Lowered r = child(l, s, {p[0], p[1], l.c(0.0f)}, inherited);
+    const NodeId d2 = unit(l.g, r);
+    r.d = l.box2_q(d2, l.sub(l.abs(p[2]), l.mul(P(s, ExtrudeP::h), l.c(0.5f))));
+    r.lip = 1.0f;
+    return r;
+}
+Bounds bounds_Extrude(const BoundsIn& b) {
+    Bounds c = b.child();
+    if (is_empty(c)) return c;
+    const float h = 0.5f * b.f(ExtrudeP::h);
+    c.lo.z = -h, c.hi.z = h;
+    return c;
+}
+
+// Quilez's revolution: the child's cross-section at z = 0 at (length(p.xz) - offset, p.y).
+Lowered lower_Revolve(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
+    Lowered r = child(l, s, {l.sub(l.len2(p[0], p[2]), P(s, RevolveP::offset)), p[1], l.c(0.0f)}, inherited);
+    return r;  // a 1-Lipschitz map of p: the child's bound holds
+}
+Bounds bounds_Revolve(const BoundsIn& b) {
+    const Bounds c = b.child();
+    if (is_empty(c)) return c;
+    const float o = b.v.at(RevolveP::offset);
+    if (!(c.lo.x > -kInf * 0.1f && c.hi.x < kInf * 0.1f)) return Bounds{{-kInf, c.lo.y, -kInf}, {kInf, c.hi.y, kInf}};
+    const float R = std::max(std::fabs(c.lo.x + o), std::fabs(c.hi.x + o));
+    return Bounds{{-R, c.lo.y, -R}, {R, c.hi.y, R}};
+}
+
 Lowered lower_Displace(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
     Graph& g = l.g;
     Lowered r = child(l, s, p, inherited);

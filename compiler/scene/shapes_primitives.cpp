@@ -21,6 +21,19 @@ Lowered lower_Sphere(L& l, const Shape& s, const Vec3N& p) {
 }
 Bounds bounds_Sphere(const BoundsIn& b) { return sym(glm::vec3(b.f(SphereP::r))); }
 
+// 2D profiles: exact in the x-y plane, so exact as prisms along z.
+Lowered lower_Circle(L& l, const Shape& s, const Vec3N& p) { return exact(l.sub(l.len2(p[0], p[1]), P(s, CircleP::r))); }
+Bounds bounds_Circle(const BoundsIn& b) { return Bounds{{-b.f(CircleP::r), -b.f(CircleP::r), -kInf}, {b.f(CircleP::r), b.f(CircleP::r), kInf}}; }
+
+Lowered lower_Square(L& l, const Shape& s, const Vec3N& p) {
+    const NodeId w = P(s, SquareP::size), h = P(s, SquareP::size_y_);
+    return exact(l.box2_q(l.sub(l.abs(p[0]), l.mul(w, l.half)), l.sub(l.abs(p[1]), l.mul(h, l.half))));
+}
+Bounds bounds_Square(const BoundsIn& b) {
+    const float w = 0.5f * std::fabs(b.v.at(SquareP::size)), h = 0.5f * std::fabs(b.v.at(SquareP::size_y_));
+    return Bounds{{-w, -h, -kInf}, {w, h, kInf}};
+}
+
 Lowered lower_Box(L& l, const Shape& s, const Vec3N& p) {
     Vec3N b = P3(s, BoxP::size), a = l.abs3(p);
     NodeId half = l.half;

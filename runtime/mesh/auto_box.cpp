@@ -17,7 +17,7 @@
 namespace sdfc::mesh {
 namespace {
 
-constexpr size_t kMaxCells = size_t(1) << 14;  // in a level's frontier: past it, no bounded solid
+constexpr size_t kMaxCells = size_t(1) << 13;  // in a level's frontier: past it, no bounded solid
 constexpr float kFinest = 1.0f / 32.0f;        // of the box's longest side
 
 struct Cell {

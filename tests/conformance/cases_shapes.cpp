@@ -137,6 +137,14 @@ void add_primitive_cases(std::vector<Case>& out) {
         .less(0, -0.3f, 0, 0);
     s.script("pyramid(4);").at(0, 2, 0, 0).at(0, -2, 0, 0);  // the apex, the centre of the base
 
+    // 2D profiles (an extension): prisms along z; extrude and revolve make solids of them.
+    s.script("circle(1);").at(2, 0, 5, 1).at(0, 0, -7, -1);
+    s.script("square([2, 1]);").at(2, 0, 3, 1).at(0, 1.5, 0, 1);
+    s.script("extrude(2) circle(1);").at(0, 0, 0, -1).at(0, 0, 1.5, 0.5).at(1.5, 0, 1.5, std::sqrt(0.5));
+    s.script("extrude(1) square([2, 1]);").at(0, 0, 0, -0.5).at(2, 0, 0, 1);
+    s.script("revolve(2) circle(0.5);").at(2, 0, 0, -0.5).at(0, 0, 2, -0.5).at(0, 0, 0, 1.5).at(2, 1, 0, 0.5);
+    s.script("revolve() translate([1, 0, 0]) square(0.5);").at(1, 0, 0, -0.25).at(0, 1, 1, 0.75);
+
     // hex_prism: along y, r is the apothem; a flat side faces +z.
     s.script("hex_prism(2, 1);").at(0, 3, 0, 2).at(0, 0, 2, 1).at(0, 0, 0, -1);
     s.script("tri_prism(2, 1);").at(0, 3, 0, 2).less(0, 0, 0, 0);
