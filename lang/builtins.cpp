@@ -328,6 +328,21 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
     if (info.kind == BuiltinKind::Shape) {
         Shape s{info.shape, loc};
         b.read(&s.params);
+        if (s.kind == ShapeKind::Polygon) {
+            // A list of at least 3 points [x, y], kept as x, y slots in turn.
+            if (!b.has(0)) fail(loc, "missing argument 'points' of polygon");
+            const Value& pts = b.val(0);
+            if (pts.t != VT::List || !pts.list || pts.list->size() < 3)
+                fail(b.loc(0), fmt::format("polygon takes a list of 3 or more points [x, y], not {}", describe(pts)));
+            if (pts.list->size() > 100000) fail(b.loc(0), "polygon has more than 100000 points");
+            for (size_t k = 0; k < pts.list->size(); ++k) {
+                const Value& q = (*pts.list)[k];
+                if (q.t != VT::Vector || q.n != 2)
+                    fail(b.loc(0), fmt::format("polygon's point {} must be [x, y], not {}", k + 1, describe(q)));
+                s.params.push_back(checked(q.c[0], b.loc(0)));
+                s.params.push_back(checked(q.c[1], b.loc(0)));
+            }
+        }
         if (s.kind == ShapeKind::Cone) {  // 0/0 in the distance: a NaN naming no parameter
             bool all_zero = true;
             for (NodeId n : s.params) all_zero &= gr.is_const(n) && gr.const_value(n) == 0.0f;

@@ -40,7 +40,9 @@ NodeId lower_distance(Graph& g, const Shape& shape, const Vec3N& p) {
 
 Lowered lower_shape(Graph& g, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
     check_stack(s.loc);
-    if (s.params.size() != shape_slots(s.kind))
+    // (A polygon's slots are its points': two each, three points or more.)
+    const bool slots_ok = s.kind == ShapeKind::Polygon ? s.params.size() >= 6 && s.params.size() % 2 == 0 : s.params.size() == shape_slots(s.kind);
+    if (!slots_ok)
         throw CompileError(s.loc, fmt::format("internal: {} has {} parameters, not {}", shape_kind_name(s.kind),
                                               s.params.size(), shape_slots(s.kind)));
     Loc saved = g.loc();

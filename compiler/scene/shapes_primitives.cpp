@@ -34,6 +34,42 @@ Bounds bounds_Square(const BoundsIn& b) {
     return Bounds{{-w, -h, -kInf}, {w, h, kInf}};
 }
 
+// Quilez's sdPolygon, unrolled over the edges: the nearest edge's distance, signed by the
+// crossings' parity (even-odd: a self-crossing outline alternates inside and outside).
+Lowered lower_Polygon(L& l, const Shape& s, const Vec3N& p) {
+    Graph& g = l.g;
+    const size_t n = s.params.size() / 2;
+    auto vx = [&](size_t i) { return s.params[2 * i]; };
+    auto vy = [&](size_t i) { return s.params[2 * i + 1]; };
+    const NodeId dx0 = l.sub(p[0], vx(0)), dy0 = l.sub(p[1], vy(0));
+    NodeId d = l.add(l.mul(dx0, dx0), l.mul(dy0, dy0));
+    NodeId odd = l.c(0.0f);
+    for (size_t i = 0; i < n; ++i) {
+        const size_t j = (i + n - 1) % n;
+        const NodeId ex = l.sub(vx(j), vx(i)), ey = l.sub(vy(j), vy(i));
+        const NodeId wx = l.sub(p[0], vx(i)), wy = l.sub(p[1], vy(i));
+        const NodeId ee = l.mx(l.add(l.mul(ex, ex), l.mul(ey, ey)), l.c(1e-30f));
+        const NodeId t = l.clamp(l.div(l.add(l.mul(wx, ex), l.mul(wy, ey)), ee), l.c(0.0f), l.c(1.0f));
+        const NodeId bx = l.sub(wx, l.mul(ex, t)), by = l.sub(wy, l.mul(ey, t));
+        d = l.mn(d, l.add(l.mul(bx, bx), l.mul(by, by)));
+        const NodeId c1 = g.binary(Op::Le, vy(i), p[1]), c2 = l.lt(p[1], vy(j)), c3 = l.lt(l.mul(ey, wx), l.mul(ex, wy));
+        const NodeId all = g.binary(Op::And, g.binary(Op::And, c1, c2), c3);
+        const NodeId none = g.binary(Op::And, g.binary(Op::And, g.unary(Op::Not, c1), g.unary(Op::Not, c2)), g.unary(Op::Not, c3));
+        odd = g.binary(Op::Ne, odd, g.binary(Op::Or, all, none));
+    }
+    return exact(l.mul(l.sel(odd, l.c(-1.0f), l.c(1.0f)), l.sqrt(d)));
+}
+Bounds bounds_Polygon(const BoundsIn& b) {
+    glm::vec2 lo(kInf), hi(-kInf);
+    for (size_t i = 0; i + 1 < b.v.size(); i += 2) {
+        const glm::vec2 q(b.v[i], b.v[i + 1]);
+        if (!std::isfinite(q.x) || !std::isfinite(q.y)) return infinite();
+        lo = glm::min(lo, q), hi = glm::max(hi, q);
+    }
+    if (b.v.size() < 2) return infinite();
+    return Bounds{{lo.x, lo.y, -kInf}, {hi.x, hi.y, kInf}};
+}
+
 Lowered lower_Box(L& l, const Shape& s, const Vec3N& p) {
     Vec3N b = P3(s, BoxP::size), a = l.abs3(p);
     NodeId half = l.half;

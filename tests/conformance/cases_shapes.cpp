@@ -144,6 +144,10 @@ void add_primitive_cases(std::vector<Case>& out) {
     s.script("extrude(1) square([2, 1]);").at(0, 0, 0, -0.5).at(2, 0, 0, 1);
     s.script("revolve(2) circle(0.5);").at(2, 0, 0, -0.5).at(0, 0, 2, -0.5).at(0, 0, 0, 1.5).at(2, 1, 0, 0.5);
     s.script("revolve() translate([1, 0, 0]) square(0.5);").at(1, 0, 0, -0.25).at(0, 1, 1, 0.75);
+    s.script("polygon([[0, 0], [2, 0], [0, 2]]);").at(0.5, 0.5, 0, -0.5).at(3, 0, 0, 1).at(-1, -1, 3, std::sqrt(2.0)).at(1, 1, 0, 0);
+    s.script("revolve() polygon([[0.5, -1], [1, -1], [1, 1], [0.5, 1]]);").at(0.75, 0, 0, -0.25).at(0, 0, 0, 0.5).at(0, 2, 0.75, 1);
+    // A concave outline (an L) and its notch.
+    s.script("polygon([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]]);").at(0.5, 0.5, 0, -0.5).at(1.5, 1.5, 0, 0.5).at(0.5, 1.5, 0, -0.5).at(3, 3, 0, std::sqrt(5.0));
 
     // hex_prism: along y, r is the apothem; a flat side faces +z.
     s.script("hex_prism(2, 1);").at(0, 3, 0, 2).at(0, 0, 2, 1).at(0, 0, 0, -1);
