@@ -44,7 +44,8 @@ usage:
               [--frames A:B --fps F] [--aov depth,normal,steps] [--view steps]
               [--threads N] [--camera-position X,Y,Z] [--camera-target X,Y,Z] [--fov DEG] [--quiet]
               [--max-steps N] [--max-bounces N] [--max-distance D] [--epsilon E] [--shadows on|off]
-              [--ao on|off] [--aa grid|cone]   (render(...)'s settings; also for bench)
+              [--ao on|off] [--aa grid|cone] [--exposure E] [--tonemap none|reinhard|aces]
+              (render(...)'s settings; also for bench)
               OUT may contain {frame:04d} (or {frame}) and {name} (the scene's file stem)
   sdfc glsl    SCENE [--target shadertoy|glsl330|html] [-o OUT]
   sdfc compile SCENE --emit ast|ir|bytecode
@@ -117,7 +118,8 @@ std::string expand(std::string out, int frame, const std::string& name) {
 using Overrides = std::vector<std::pair<std::string, std::optional<std::string>>>;
 // The flags that override the script's camera and render(...) settings (render and bench).
 constexpr const char* kOverrideFlags[] = {"--width",     "--height",  "--samples", "--camera-position", "--camera-target", "--fov",
-                                          "--max-steps", "--max-bounces", "--max-distance", "--epsilon", "--shadows", "--ao", "--aa"};
+                                          "--max-steps", "--max-bounces", "--max-distance", "--epsilon", "--shadows", "--ao", "--aa",
+                                          "--exposure",  "--tonemap"};
 
 bool ov_has(const Overrides& ov, const char* flag) {
     for (auto& [k, v] : ov)
@@ -149,6 +151,14 @@ void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
             if (*v != "on" && *v != "off") throw UsageError(fmt::format("{} takes on or off, not '{}'", flag, *v));
             *field = *v == "on";
         }
+    if (auto v = a.value("--exposure")) {
+        cs.render.exposure = Args::to_float("--exposure", *v);
+        if (!(cs.render.exposure > 0.0f)) throw UsageError(fmt::format("--exposure must be above 0, not {}", *v));
+    }
+    if (auto v = a.value("--tonemap")) {
+        if (*v != "none" && *v != "reinhard" && *v != "aces") throw UsageError(fmt::format("--tonemap takes none, reinhard or aces, not '{}'", *v));
+        cs.render.tonemap = *v;
+    }
     if (auto v = a.value("--aa")) {
         if (*v != "grid" && *v != "cone") throw UsageError(fmt::format("--aa takes grid or cone, not '{}'", *v));
         cs.render.aa = *v;

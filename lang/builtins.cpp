@@ -67,7 +67,7 @@ std::vector<BuiltinInfo> make_table() {
     add(B::Render, "render", K::Setting,
         {opt("width", P::Num, 640), opt("height", P::Num, 480), opt("samples", P::Num, 1), opt("max_steps", P::Num, 256),
          opt("max_distance", P::Num, 100), opt("epsilon", P::Num, 1e-4f), opt("shadows", P::Bool, 1), opt("ao", P::Bool, 1),
-         opt("max_bounces", P::Num, 3), opt("aa", P::String, 0)});
+         opt("max_bounces", P::Num, 3), opt("aa", P::String, 0), opt("exposure", P::Num, 1), opt("tonemap", P::String, 0)});
     // Math: parameters are checked by call_math.
 #define SDFC_BUILTIN(i, n, k) \
     if (K::k == K::Math) add(B::i, n, K::Math, {});
@@ -480,6 +480,17 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
                 const std::string& aa = *b.val(9).str;
                 if (aa != "grid" && aa != "cone") fail(b.loc(9), fmt::format("aa must be \"grid\" or \"cone\", not \"{}\"", aa));
                 r.aa = aa;
+            }
+            if (b.has(10)) {
+                r.exposure = const_num(b.val(10), b.loc(10), "exposure");
+                if (!(r.exposure > 0.0f) || !std::isfinite(r.exposure))
+                    fail(b.loc(10), fmt::format("render exposure must be a number above 0, not {}", r.exposure));
+            }
+            if (b.has(11)) {
+                const std::string& tm = *b.val(11).str;
+                if (tm != "none" && tm != "reinhard" && tm != "aces")
+                    fail(b.loc(11), fmt::format("tonemap must be \"none\", \"reinhard\" or \"aces\", not \"{}\"", tm));
+                r.tonemap = tm;
             }
             break;
         }

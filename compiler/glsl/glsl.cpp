@@ -132,9 +132,12 @@ Parts generate(const Scene& scene, FieldSampler sample) {
         "const int SDF_MAX_BOUNCES = {};\n"
         "const bool SDF_CONE = {};  // cone-traced anti-aliasing (render(aa = \"cone\"))\n"
         "const bool SDF_2D = {};  // a 2D model: the Prospero image\n"
-        "const bool SDF_ORTHO = {};  // orthographic camera\n",
+        "const bool SDF_ORTHO = {};  // orthographic camera\n"
+        "const float SDF_EXPOSURE = {};\n"
+        "const int SDF_TONEMAP = {};  // 0 none, 1 Reinhard, 2 ACES\n",
         plan.max_steps, literal(plan.max_dist), literal(plan.eps), plan.shadows ? "true" : "false", plan.ao ? "true" : "false",
-        plan.max_bounces, plan.cone ? "true" : "false", plan.is_2d ? "true" : "false", cam.orthographic ? "true" : "false");
+        plan.max_bounces, plan.cone ? "true" : "false", plan.is_2d ? "true" : "false", cam.orthographic ? "true" : "false",
+        literal(plan.exposure), plan.tonemap);
     c += fmt::format("const int SDF_SAMPLES = {};  // samples per pixel\nconst vec2 SDF_OFFSETS[SDF_SAMPLES] = vec2[SDF_SAMPLES](", plan.samples);
     for (int i = 0; i < plan.samples; ++i)
         c += fmt::format("{}vec2({}, {})", i ? (i % 4 == 0 ? ",\n    " : ", ") : "", literal(plan.offsets[i].x), literal(plan.offsets[i].y));

@@ -369,5 +369,6 @@ vec4 sdf_render(vec2 frag_coord, vec2 res, float time, vec4 orbit, vec2 pan) {
         acc += sdf_trace(o, d, SDF_SAMPLE_WEIGHT);
     }
     acc = vec3(acc.x >= 0.0 ? min(acc.x, 1e30) : 0.0, acc.y >= 0.0 ? min(acc.y, 1e30) : 0.0, acc.z >= 0.0 ? min(acc.z, 1e30) : 0.0);
+    acc = vec3(sdf_tonemap1(acc.x, SDF_EXPOSURE, SDF_TONEMAP), sdf_tonemap1(acc.y, SDF_EXPOSURE, SDF_TONEMAP), sdf_tonemap1(acc.z, SDF_EXPOSURE, SDF_TONEMAP));
     return vec4(sdf_to_srgb(acc.x), sdf_to_srgb(acc.y), sdf_to_srgb(acc.z), 1.0);
 }

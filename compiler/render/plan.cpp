@@ -124,6 +124,8 @@ RenderPlan resolve_plan(const PlanInputs& in) {
     p.max_dist = std::isfinite(rs.max_distance) && rs.max_distance > 0 ? rs.max_distance : 100.0f;
     if (!rs.max_distance_set) p.max_dist = fitted_max_distance(in, p.max_dist);
     p.shadows = rs.shadows;
+    p.exposure = std::isfinite(rs.exposure) && rs.exposure > 0.0f ? rs.exposure : 1.0f;
+    p.tonemap = rs.tonemap == "aces" ? 2 : rs.tonemap == "reinhard" ? 1 : 0;
     p.ao = rs.ao && !p.raw;
 
     const Bounds& b = in.bounds.bounds;

@@ -22,6 +22,8 @@ struct RenderPlan {
     int max_steps = 256, max_bounces = 3;
     float eps = 1e-4f, max_dist = 100.0f;
     bool shadows = true, ao = true;  // ao: never for raw fields
+    float exposure = 1.0f;
+    int tonemap = 0;  // 0 none, 1 Reinhard, 2 ACES (rules.h sdf_tonemap)
     bool cone = false;               // cone-traced anti-aliasing (render(aa = "cone"))
     bool is_2d = false;              // a 2D model: the Prospero image
     bool raw = false;                // a raw field (.vm model): no distance bound, sign-change marching

@@ -259,6 +259,16 @@ SDF_FN vec3 sdf_facing_normal(vec3 n, vec3 d, bool inside) {
     return normalize(n - d * (dn + 0.05f));
 }
 
+// The picture from the radiance a pixel gathered (never NaN, >= 0): times the exposure,
+// then mapped (0: none, the encoding clips at 1; 1: Reinhard's c / (1 + c); 2: ACES, in
+// Narkowicz's fit), before the sRGB encoding.
+SDF_FN float sdf_tonemap1(float c, float exposure, int mode) {
+    float x = c * exposure;
+    if (mode == 1) return x / (1.0f + x);
+    if (mode == 2) return sdf_clamp01((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f));
+    return x;
+}
+
 // Material channels made safe to shade with (no NaN/inf, sensible ranges): colours,
 // specular and emission >= 0, reflectance and transparency in [0, 1], and these two.
 SDF_FN float sdf_safe_shininess(float v) { return sdf_finite(v) ? clamp(v, 0.0f, 1e4f) : 32.0f; }

@@ -135,6 +135,8 @@ struct RenderSettings {
     bool max_distance_set = false;  // by the script or a flag: else the plan fits it to the scene
     bool shadows = true, ao = true;
     std::string aa = "grid";  // "grid" (stratified supersampling) or "cone"
+    float exposure = 1.0f;          // the picture's radiance is multiplied by it, then
+    std::string tonemap = "none";   // mapped: "none" (clipped at 1), "reinhard" or "aces"
 };
 
 struct Scene {

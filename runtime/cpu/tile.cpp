@@ -111,7 +111,8 @@ void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* d
             } else {
                 for (int c = 0; c < 3; ++c) {
                     const float v = accum_[p * 3 + c];
-                    img.pixels[o * 3 + c] = v >= 0.0f ? std::min(v, 1e30f) : 0.0f;  // never NaN or inf
+                    const float r = v >= 0.0f ? std::min(v, 1e30f) : 0.0f;  // never NaN or inf
+                    img.pixels[o * 3 + c] = f_.exposure == 1.0f && f_.tonemap == 0 ? r : std::min(rules::sdf_tonemap1(r, f_.exposure, f_.tonemap), 1e30f);
                 }
             }
             if (depth) depth->data[o] = std::isfinite(dmin) ? dmin : f_.max_dist;

@@ -17,7 +17,6 @@
 namespace sdfc::mesh {
 namespace {
 
-constexpr size_t kMaxCells = size_t(1) << 13;  // in a level's frontier: past it, no bounded solid
 constexpr float kFinest = 1.0f / 32.0f;        // of the box's longest side
 
 struct Cell {
@@ -26,7 +25,8 @@ struct Cell {
 
 }  // namespace
 
-bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3& lo, glm::vec3& hi) {
+// (max_cells: a level's frontier past it ends the search: no bounded solid, or a coarser box)
+bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3& lo, glm::vec3& hi, size_t max_cells) {
     if (distance.outputs.empty()) return false;
     Tape tape = Tape::from(distance, 0);
     tape.link();
@@ -93,7 +93,7 @@ bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3
         const float size = next[0].hi.x - next[0].lo.x;  // every cell of a level is a cube of one size
         const float longest = std::max({bhi.x - blo.x, bhi.y - blo.y, bhi.z - blo.z});
         frontier = std::move(next);
-        if (size <= kFinest * longest || frontier.size() > kMaxCells) break;
+        if (size <= kFinest * longest || frontier.size() > max_cells) break;
     }
     glm::vec3 blo = solid_lo, bhi = solid_hi;
     for (const Cell& c : frontier) grow(blo, bhi, c);
@@ -104,7 +104,7 @@ bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3
     return true;
 }
 
-bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float time) {
+bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float time, size_t search_cells) {
     if (scene.raw_field) {
         lo = glm::vec3(-1.0f), hi = glm::vec3(1.0f);
         return true;
@@ -115,7 +115,7 @@ bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float
     if (!b.finite() || !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) {
         // The shapes do not tell (a custom field): the intervals, without the floors if any.
         const Program& p = scene.solid.outputs.empty() ? scene.distance : scene.solid;
-        if (!interval_box(p, true, time, blo, bhi)) return false;
+        if (!interval_box(p, true, time, blo, bhi, search_cells)) return false;
     }
     const glm::vec3 ext = bhi - blo;
     const float m = 0.02f * std::max({ext.x, ext.y, ext.z, 1e-3f});

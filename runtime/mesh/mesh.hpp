@@ -74,13 +74,14 @@ Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* sta
 // rest, which cuts a floor into a thin base), a .vm model's [-1, 1]^3. Where the scene's
 // shapes give no bounds (a custom field), the intervals find them (auto_box.cpp). False
 // when the scene is unbounded (an infinite repetition, only a plane): --bounds is needed.
-bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float time = 0.0f);
+// `search_cells` caps the interval search's frontier (its cost; the fuzz target keeps it small).
+bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float time = 0.0f, size_t search_cells = 8192);
 
 // A box holding every point the interval evaluator does not prove outside, searched within
 // [-kSearch, kSearch]^3 to about 1/32 of the solid's size; false if that reaches the search
 // cube's faces (no bounded solid) or finds nothing. A distance bound (lipschitz) is also
 // bounded by its value at each cell's centre.
 inline constexpr float kSearch = 1.0e4f;
-bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3& lo, glm::vec3& hi);
+bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3& lo, glm::vec3& hi, size_t max_cells = 8192);
 
 }  // namespace sdfc::mesh

@@ -72,7 +72,8 @@ inline std::string evaluate(const CompiledScene& cs) {
 inline std::string mesh_check(const CompiledScene& cs) {
     if (cs.is_2d) return "";
     mesh::MeshOptions o;
-    if (!mesh::default_box(cs, o.lo, o.hi, cs.time)) o.lo = glm::vec3(-2.0f), o.hi = glm::vec3(2.0f);
+    // A small interval search (custom fields): fuzzing stays fast.
+    if (!mesh::default_box(cs, o.lo, o.hi, cs.time, 256)) o.lo = glm::vec3(-2.0f), o.hi = glm::vec3(2.0f);
     const glm::vec3 ext = o.hi - o.lo;
     if (!(std::max({ext.x, ext.y, ext.z}) < 1e30f)) return "";
     o.resolution = 6;

@@ -79,3 +79,25 @@ TEST_CASE("shading: no black pixels on a Menger field or a displaced plane at gr
               320, 180) == 0);
     CHECK(black_surface_pixels("camera(position = [0, 0.4, 6], target = [0, 0, -10]); displace(0.05, 4) plane();", 320, 180) == 0);
 }
+
+TEST_CASE("exposure scales the picture's radiance, tone mapping maps it", "[render]") {
+    const std::string scene = "camera(position = [0, 0, 5]); background([0.2, 0.1, 0.05]); sphere(1);";
+    auto pixels = [&](const std::string& settings) {
+        auto c = compile_text(settings + scene);
+        c->cs.render.width = 16, c->cs.render.height = 12;
+        return render(c->cs, {});
+    };
+    const Image plain = pixels(""), twice = pixels("render(exposure = 2);"), reinhard = pixels("render(tonemap = \"reinhard\");"),
+                aces = pixels("render(exposure = 1, tonemap = \"aces\");");
+    const float bg = plain.at(0, 0, 0);
+    CHECK(bg == Approx(0.2f));
+    CHECK(twice.at(0, 0, 0) == Approx(0.4f));
+    CHECK(reinhard.at(0, 0, 0) == Approx(0.2f / 1.2f));
+    const float x = 0.2f;
+    CHECK(aces.at(0, 0, 0) == Approx((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f)));
+    for (int y = 0; y < 12; ++y)
+        for (int xx = 0; xx < 16; ++xx) {
+            CHECK(twice.at(xx, y, 1) == Approx(2.0f * plain.at(xx, y, 1)));
+            CHECK(aces.at(xx, y, 1) <= 1.0f);
+        }
+}
