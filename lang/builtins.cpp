@@ -366,6 +366,19 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
         MaterialN mat;
         if (info.id == B::Color) {
             mat = default_material(gr);
+            if (b.has(0) && b.val(0).t == VT::Shape && b.val(0).shape->kind == ShapeKind::Field && b.val(0).shape->field_rgb) {
+                // A colour that varies with the point: a modifier carrying the field's body.
+                auto mv = std::make_shared<ModifierVal>();
+                mv->id = B::Color;
+                mv->name = "color";
+                mv->loc = loc;
+                mv->material = mat;
+                mv->color_at = b.val(0).shape->field_rgb;
+                Value v;
+                v.t = VT::Modifier;
+                v.mod = mv;
+                return v;
+            }
             if (b.has(0)) {
                 const Value& c = b.val(0);
                 if (c.t == VT::String) {
@@ -606,6 +619,7 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
         case B::Color:
             s.kind = ShapeKind::Material;
             s.material = m.material;
+            s.color_at = m.color_at;
             s.children = {target};
             break;
         default: {

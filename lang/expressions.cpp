@@ -241,6 +241,17 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                 if (v.t != VT::Number) fail(body->loc, fmt::format("a field must compute a number (the distance), not {}", describe(v)));
                 return v.c[0];
             };
+            s.field_rgb = [this, env, body, param, ploc](Graph&, const Vec3N& p) -> Vec3N {
+                count_calls(1, ploc);
+                const size_t mark = envs.size();
+                Env* fe = new_env(env, true);
+                fe->vars[param] = Binding{Value::vector(p.data(), 3), false, ploc};
+                Value v = eval(*body, fe);
+                release_envs(mark);
+                if (v.t != VT::Vector || v.n != 3)
+                    fail(body->loc, fmt::format("a colour field must compute [r, g, b], not {}", describe(v)));
+                return {v.c[0], v.c[1], v.c[2]};
+            };
             return Value::of_shape(make_shape(std::move(s)));
         }
     }

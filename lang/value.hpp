@@ -34,6 +34,7 @@ struct ModifierVal {
     Loc loc;
     std::shared_ptr<const BoundArgs> args;
     MaterialN material{};  // for material()/color()
+    ColorFn color_at;      // color(field (p) -> [r, g, b]): the colour at each point
 };
 
 struct RangeVal {

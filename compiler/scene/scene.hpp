@@ -93,6 +93,8 @@ using ShapePtr = std::shared_ptr<const Shape>;
 // A custom field's body, evaluated by the interpreter on a symbolic point. Returns the raw
 // distance node (the compiler divides by `bound`).
 using FieldFn = std::function<NodeId(Graph&, const Vec3N& p)>;
+// The same body read as a colour, [r, g, b] at the point (`color(field (p) -> ...)`).
+using ColorFn = std::function<Vec3N(Graph&, const Vec3N& p)>;
 
 struct Shape {
     ShapeKind kind;
@@ -104,6 +106,8 @@ struct Shape {
     std::vector<ShapePtr> children;
     MaterialN material{};  // Material
     FieldFn field;         // Field
+    ColorFn field_rgb;     // Field: its body as a colour
+    ColorFn color_at;      // Material: when set, the colour at each point (local coordinates)
     float bound = 1.0f;    // Field: the user's Lipschitz bound
     int depth = 1;         // height of this subtree (bounded so lowering cannot overflow the stack)
     size_t tree_size = 1;  // shapes lowering visits here: this one and its subtree, a shared child at each use

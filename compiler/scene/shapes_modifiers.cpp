@@ -379,6 +379,12 @@ Bounds bounds_Displace(const BoundsIn& b) { return grow(b.child(), b.f(DisplaceP
 Lowered lower_Material(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
     // The inner material wins: this one only reaches shapes that have none of their own,
     // so it replaces what the enclosing scope passed down.
+    if (inherited && s.color_at) {  // a colour field: its colour at this point
+        MaterialN m = s.material;
+        const Vec3N c = s.color_at(l.g, p);
+        for (int k = 0; k < 3; ++k) m[size_t(kMatR + k)] = c[size_t(k)];
+        return child(l, s, p, &m);
+    }
     return child(l, s, p, inherited ? &s.material : nullptr);
 }
 Bounds bounds_Material(const BoundsIn& b) { return b.child(); }

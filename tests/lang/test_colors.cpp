@@ -12,11 +12,10 @@ using namespace sdfc::test;
 
 namespace {
 
-// The material colour at the origin (the shading program's colour outputs, linear).
-glm::vec3 colour_of(const std::string& src) {
+// The material colour at a point (the shading program's colour outputs, linear).
+glm::vec3 colour_of(const std::string& src, float x = 0, float y = 0, float z = 0) {
     auto c = compile_text(src);
     Evaluator ev(c->cs.shading);
-    float x = 0, y = 0, z = 0;
     ev.eval(&x, &y, &z, 1);
     return {ev.output(1 + kMatR)[0], ev.output(2 + kMatR)[0], ev.output(3 + kMatR)[0]};
 }
@@ -50,4 +49,20 @@ TEST_CASE("an unknown colour name says which it could be", "[lang]") {
     CHECK(first_error_line("color(\"nosuchxyz\") sphere(1);") ==
           "test.sdf:1:7: error: unknown colour \"nosuchxyz\" (a CSS name such as \"tomato\", or \"#rrggbb\")");
     CHECK(first_error_line("color(3) sphere(1);") == "test.sdf:1:7: error: color takes [r, g, b] or a colour name such as \"tomato\", not a number");
+}
+
+TEST_CASE("a colour field gives each point its colour, in local coordinates, blended by smooth operations", "[lang]") {
+    const std::string checker = "color(field (p) -> (mod(floor(p.x) + floor(p.z), 2) < 1) ? [1, 1, 1] : [0, 0, 0]) box([8, 0.2, 8]);";
+    CHECK(colour_of(checker, 0.5f, 0.1f, 0.5f).r == Approx(1.0f));
+    CHECK(colour_of(checker, 1.5f, 0.1f, 0.5f).r == Approx(0.0f));
+    CHECK(colour_of(checker, 1.5f, 0.1f, 1.5f).r == Approx(1.0f));
+    // In the shape's own coordinates: translated with it.
+    const std::string moved = "translate([10, 0, 0]) color(field (p) -> [p.x, 0, 0]) sphere(1);";
+    CHECK(colour_of(moved, 10.5f, 0, 0).r == Approx(0.5f));
+    // A smooth union blends it with its neighbour's colour between them.
+    const std::string blend = "smooth_union(1) { color(field (p) -> [1, 0, 0]) sphere(1); translate([2, 0, 0]) color([0, 0, 1]) sphere(1); }";
+    const glm::vec3 mid = colour_of(blend, 1, 0, 0);
+    CHECK(mid.r == Approx(0.5f).margin(0.05f));
+    CHECK(mid.b == Approx(0.5f).margin(0.05f));
+    CHECK(first_error_line("color(field (p) -> 3) sphere(1);") == "test.sdf:1:20: error: a colour field must compute [r, g, b], not a number");
 }
