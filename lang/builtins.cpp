@@ -162,7 +162,12 @@ struct Binder {
         };
         switch (p.type) {
             case PT::Num: if (v.t != VT::Number) bad("a number"); break;
-            case PT::Vec3: if (!(v.t == VT::Vector && v.n == 3)) bad("a 3-component vector"); break;
+            case PT::Vec3:
+                // material(color = field (p) -> [r, g, b]): a colour that varies with the point.
+                if (info.id == Builtin::MaterialFn && std::string_view(p.name) == "color" && v.t == VT::Shape && v.shape->kind == ShapeKind::Field)
+                    break;
+                if (!(v.t == VT::Vector && v.n == 3)) bad("a 3-component vector");
+                break;
             case PT::NumOrVec3: if (!(v.t == VT::Number || (v.t == VT::Vector && v.n == 3))) bad("a number or a 3-component vector"); break;
             case PT::NumOrVec2: if (!(v.t == VT::Number || (v.t == VT::Vector && v.n == 2))) bad("a number or a 2-component vector"); break;
             case PT::Vec: if (v.t != VT::Vector) bad("a vector"); break;
@@ -286,12 +291,17 @@ void push3(std::vector<NodeId>& v, const Vec3N& a) { v.insert(v.end(), a.begin()
 
 // material()'s arguments over `base` (or the defaults): parameter 0 is the base itself,
 // then one per script parameter of materials.def, a 3-vector or a size.
-MaterialN material_from(Interp& in, Binder& b, const MaterialN* base) {
+// (A colour field given for `color` is left to the caller: `field_rgb` receives it.)
+MaterialN material_from(Interp& in, Binder& b, const MaterialN* base, ColorFn* field_rgb = nullptr) {
     MaterialN m = base ? *base : default_material(*in.g);
     size_t i = 0;
     for (int ch = 0; ch < kMatChannels; ++ch) {
         if (kMatChannelInfo[ch].component != 0) continue;  // a vector's later components
         if (!b.has(++i)) continue;
+        if (b.val(i).t == VT::Shape) {
+            if (field_rgb) *field_rgb = b.val(i).shape->field_rgb;
+            continue;
+        }
         if (b.info.params[i].type == PT::Vec3) {
             Vec3N v = b.vec3(i);
             for (int k = 0; k < 3; ++k) m[ch + k] = v[k];
@@ -408,7 +418,20 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
             }
         } else {
             const MaterialN* base = b.has(0) ? b.val(0).mat.get() : nullptr;
-            mat = material_from(*this, b, base);
+            ColorFn field_rgb;
+            mat = material_from(*this, b, base, &field_rgb);
+            if (field_rgb) {  // a modifier, as color(field ...) is
+                auto mv = std::make_shared<ModifierVal>();
+                mv->id = B::MaterialFn;
+                mv->name = "material";
+                mv->loc = loc;
+                mv->material = mat;
+                mv->color_at = field_rgb;
+                Value v;
+                v.t = VT::Modifier;
+                v.mod = mv;
+                return v;
+            }
         }
         Value v;
         v.t = VT::Material;

@@ -65,4 +65,6 @@ TEST_CASE("a colour field gives each point its colour, in local coordinates, ble
     CHECK(mid.r == Approx(0.5f).margin(0.05f));
     CHECK(mid.b == Approx(0.5f).margin(0.05f));
     CHECK(first_error_line("color(field (p) -> 3) sphere(1);") == "test.sdf:1:20: error: a colour field must compute [r, g, b], not a number");
+    // material(color = field ...) too, its other channels as given.
+    CHECK(colour_of("material(color = field (p) -> [p.x, 0, 0], specular = 0.2) sphere(1);", 0.5f, 0, 0).r == Approx(0.5f));
 }

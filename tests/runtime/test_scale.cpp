@@ -2,6 +2,8 @@
 // scene's bounds and the camera, so a scene in millimetres renders as one in metres.
 #include <catch2/catch.hpp>
 
+#include <fmt/format.h>
+
 #include "compiler/render/plan.hpp"
 #include "runtime/cpu/tracer.hpp"
 #include "support.hpp"
@@ -100,4 +102,22 @@ TEST_CASE("exposure scales the picture's radiance, tone mapping maps it", "[rend
             CHECK(twice.at(xx, y, 1) == Approx(2.0f * plain.at(xx, y, 1)));
             CHECK(aces.at(xx, y, 1) <= 1.0f);
         }
+}
+
+TEST_CASE("scale: a scene with the default lights looks the same from 0.01 to 1000 units", "[render]") {
+    auto mean = [](float s) {
+        const std::string src = fmt::format(
+            "camera(position = [{0}, {1}, {2}], target = [0, 0, 0]); sphere({3}); translate([0, {4}, 0]) box([{5}, {6}, {5}]);",
+            3 * s, 2 * s, 4 * s, s, -1.2f * s, 6 * s, 0.2f * s);
+        auto c = compile_text(src);
+        c->cs.render.width = 64, c->cs.render.height = 48;
+        const Image img = render(c->cs, {});
+        double sum = 0.0;
+        for (float v : img.pixels) sum += v;
+        return sum / double(img.pixels.size());
+    };
+    const double unit = mean(1.0f);
+    CHECK(unit > 0.05);
+    CHECK(mean(0.01f) == Approx(unit).epsilon(0.03));
+    CHECK(mean(1000.0f) == Approx(unit).epsilon(0.03));
 }
