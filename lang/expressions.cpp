@@ -68,6 +68,24 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             std::vector<Value> items;
             bool all_num = true;
             for (const auto& el : e.elems) {
+                if (el->kind == K::For) {
+                    // A list comprehension, as OpenSCAD's: `[for (i = [0 : 9]) f(i)]` gives the
+                    // iterations' values (an `if` without `else` that is false gives none).
+                    run_for(el->bindings, env, el->loc, [&](Env* body) {
+                        const ast::Expr* b = el->block ? nullptr : el->body.get();
+                        if (b && b->kind == K::If && (b->elems.size() < 3 || !b->elems[2])) {  // a filter
+                            const std::optional<bool> keep = const_truth(eval(*b->elems[0], body), b->elems[0]->loc);
+                            if (!keep) fail(b->elems[0]->loc, "a list comprehension's condition must be a constant");
+                            if (!*keep) return;
+                            b = b->elems[1].get();
+                        }
+                        Value v = el->block ? eval_block(*el->block, body, false) : eval(*b, body);
+                        if (v.t == VT::None) return;
+                        all_num &= v.t == VT::Number;
+                        items.push_back(std::move(v));
+                    });
+                    continue;
+                }
                 items.push_back(eval(*el, env));
                 all_num &= items.back().t == VT::Number;
             }

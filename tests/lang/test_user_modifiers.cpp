@@ -31,3 +31,15 @@ TEST_CASE("a user modifier's errors name it", "[lang]") {
     CHECK(first_error_line("def at(v, s) = translate(v) s;\nlet k = 3;\nat([1, 0, 0]) k;") ==
           "test.sdf:3:15: error: the target of at must be a shape, not a number");
 }
+
+TEST_CASE("list comprehensions give the iterations' values, an if without else none", "[lang]") {
+    // [0, 1, 4, 9, 16]: the sphere's radius is 16 / 16.
+    CHECK(dist_of("let l = [for (i = [0 : 4]) i * i]; sphere(l[4] / 16);", 0, 0, 0) == Approx(-1.0f));
+    // Three numbers make a vector, as a literal's do.
+    CHECK(dist_of("translate([for (i = [0 : 2]) i]) sphere(1);", 0, 1, 2) == Approx(-1.0f));
+    // A filter: [0, 2, 4], the last is 4.
+    CHECK(dist_of("let l = [for (i = [0 : 5]) if (i % 2 == 0) i]; sphere(l[2]);", 0, 0, 0) == Approx(-4.0f));
+    // An outline for polygon: a square from its corners.
+    CHECK(dist_of("extrude(2) polygon([for (a = [45 : 90 : 315]) [cos(radians(a)), sin(radians(a))] * sqrt(2)]);", 0, 0, 0) ==
+          Approx(-1.0f).margin(1e-5));
+}
