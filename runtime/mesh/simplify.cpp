@@ -1,16 +1,18 @@
 // Edge-collapse simplification (simplify.hpp), in rounds so the field is asked in batches:
 //
 //   quadrics  every vertex starts with the planes of its triangles, weighted by area
-//   queue     every edge's collapse (a bucket queue by cost): the point its two quadrics' sum puts it at (qef.hpp,
-//             or an end or the middle when those are better or the solution strays), and
-//             its cost, the RMS distance of that point to the planes merged
-//   round     cheapest first, collapses are taken whose neighbourhoods do not overlap
-//             (one round's collapses are independent of each other), once their topology
-//             and geometry pass; the field is then asked at their new vertices and new
-//             triangles' centroids in one batch, and those within the tolerance are made
+//   queue     every edge's collapse in a bucket queue by cost: the RMS distance to the
+//             planes merged of the point their quadrics' sum puts it at (qef.hpp; an end or
+//             the middle when better, or when the solution strays)
+//   round     cheapest first, up to 1024 collapses whose neighbourhoods do not overlap are
+//             taken; being independent, they are planned and checked (topology, geometry)
+//             in parallel, the field is asked at their probes (the new vertex; a new
+//             triangle's centroid where the surface may sag) in one batch, and those
+//             within the tolerance are made, in parallel too
 //   again     a collapse changes one vertex: only its edges are queued again; stale
 //             entries are skipped by a version stamp. When the queue runs out, every edge
-//             is queued once more (a neighbour's change may have unblocked it)
+//             is queued once more (a neighbour's change may have unblocked it), at most
+//             kPasses times, skipping the collapses the field refused unchanged
 #include "runtime/mesh/simplify.hpp"
 
 #include <tbb/blocked_range.h>
@@ -44,7 +46,7 @@ struct Collapse {
     glm::vec3 p;
 };
 
-// A collapse waiting its turn, small so the heap stays in cache; its point is worked out
+// A collapse waiting its turn, small so the queue stays in cache; its point is worked out
 // again when it comes up.
 struct Queued {
     float cost;
