@@ -73,7 +73,7 @@ Safety limits (defaults in docs/language.md): --max-recursion N, --max-iteration
 --max-calls N, --max-shapes N, --max-shape-depth N, --max-ops N, --max-file-size BYTES,
 --max-pixels N (width*height*samples), --max-frames N, --max-nesting N.
 Every command: -D NAME=VALUE sets the script's top-level `let NAME` to VALUE (an
-expression: -D size=2, -D 'color=[1, 0, 0]'), as OpenSCAD's -D does.
+expression: -D size=2, -D 'tint=[1, 0, 0]'), as OpenSCAD's -D does.
 )";
 
 // --format: the image format of standard output (-o -); a file's extension names its own.
