@@ -13,7 +13,7 @@ float sdf_grad3(uint h, vec3 p) {
 }
 float sdf_noise(vec3 q) {
     vec3 f = floor(q);
-    uvec3 i = uvec3(ivec3(f));
+    uvec3 i = uvec3(ivec3(clamp(f, vec3(-2147483520.0), vec3(2147483520.0))));  // in int's range, as the C++
     vec3 x = q - f;
     vec3 w = x * x * x * (x * (x * 6.0 - 15.0) + 10.0);
     float g000 = sdf_grad3(sdf_hash3(i.x, i.y, i.z), x);

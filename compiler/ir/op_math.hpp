@@ -36,9 +36,13 @@ inline float fade(float t) { return t * t * t * (t * (t * 6.0f - 15.0f) + 10.0f)
 inline float lerp(float a, float b, float t) { return a + (b - a) * t; }
 inline float noise3(float px, float py, float pz) {
     float fx = std::floor(px), fy = std::floor(py), fz = std::floor(pz);
-    uint32_t ix = static_cast<uint32_t>(static_cast<int32_t>(fx));
-    uint32_t iy = static_cast<uint32_t>(static_cast<int32_t>(fy));
-    uint32_t iz = static_cast<uint32_t>(static_cast<int32_t>(fz));
+    // The lattice cell as an int, kept in int's range (a huge or NaN coordinate, say from
+    // displace(a, 1e30), would make the conversion undefined; in range nothing changes).
+    auto cell = [](float f) {
+        constexpr float kMax = 2147483520.0f;  // the largest float below 2^31
+        return static_cast<uint32_t>(static_cast<int32_t>(f >= -kMax ? (f <= kMax ? f : kMax) : -kMax));
+    };
+    uint32_t ix = cell(fx), iy = cell(fy), iz = cell(fz);
     float x = px - fx, y = py - fy, z = pz - fz;
     float u = fade(x), v = fade(y), w = fade(z);
     auto g = [&](uint32_t dx, uint32_t dy, uint32_t dz) {
