@@ -1,5 +1,6 @@
 #include "cli/args.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -9,8 +10,22 @@
 
 namespace sdfc::cli {
 
+void Args::declare(std::vector<std::string> names) {
+    known_ = std::move(names);
+    declared_ = true;
+}
+
+void Args::ask(const std::string& name) {
+    if (!declared_) {
+        known_.push_back(name);
+        return;
+    }
+    if (std::find(known_.begin(), known_.end(), name) == known_.end())
+        throw std::logic_error(fmt::format("internal: the option {} is read but not in the option table (cli/options.cpp)", name));
+}
+
 bool Args::flag(const std::string& name) {
-    known_.push_back(name);
+    ask(name);
     bool found = false;
     for (size_t i = 0; i < end_; ++i)
         if (!used_[i] && args_[i] == name) used_[i] = found = true;
@@ -18,8 +33,8 @@ bool Args::flag(const std::string& name) {
 }
 
 std::optional<std::string> Args::value(const std::string& name, const std::string& alt) {
-    known_.push_back(name);
-    if (!alt.empty()) known_.push_back(alt);
+    ask(name);
+    if (!alt.empty()) ask(alt);
     std::optional<std::string> v;
     for (size_t i = 0; i < end_; ++i) {
         if (used_[i]) continue;
@@ -44,7 +59,7 @@ std::optional<std::string> Args::value(const std::string& name, const std::strin
 }
 
 std::vector<std::string> Args::values(const std::string& name) {
-    known_.push_back(name);
+    ask(name);
     std::vector<std::string> out;
     for (size_t i = 0; i < end_; ++i) {
         if (used_[i]) continue;

@@ -24,6 +24,10 @@ public:
             }
     }
 
+    // The options the command takes (its row of the option table): asking for another is a
+    // bug in sdfc (std::logic_error), and did-you-mean picks among them all.
+    void declare(std::vector<std::string> names);
+
     bool flag(const std::string& name);  // --name (no value)
     std::optional<std::string> value(const std::string& name, const std::string& alt = "");  // --name V or --name=V
     // Every value of a short option that may repeat: -D V, -DV.
@@ -39,7 +43,9 @@ public:
 private:
     std::vector<std::string> args_;
     std::vector<bool> used_;
-    std::vector<std::string> known_;  // the options asked for, for did-you-mean
+    void ask(const std::string& name);  // a name the command reads: known, and declared
+    std::vector<std::string> known_;  // the options asked for (or declared), for did-you-mean
+    bool declared_ = false;
     size_t end_ = 0;                  // options end here (at `--`, or the end)
 };
 

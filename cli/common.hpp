@@ -40,6 +40,8 @@ double progress_after_s();
 void progress_line(const std::string& target, double frac, double elapsed_s, double eta, const std::string& label = "");
 
 int cmd_mesh(Args& a);
+// `sdfc preview` (preview_command.cpp): serves the live page until Ctrl-C.
+int cmd_preview(Args& a);
 // `sdfc watch` (watch_command.cpp): `run` runs one command line, its errors reported.
 int cmd_watch(const std::vector<std::string>& args, int (*run)(const std::vector<std::string>&));
 

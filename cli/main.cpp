@@ -18,6 +18,7 @@
 
 #include "cli/args.hpp"
 #include "cli/common.hpp"
+#include "cli/options.hpp"
 #include "cli/output_checks.hpp"
 #include "compiler/bytecode/compile.hpp"
 #include "compiler/glsl/glsl.hpp"
@@ -36,45 +37,6 @@
 
 namespace sdfc::cli {
 namespace {
-
-const char* kUsage = R"(sdfc — compile and render .sdf signed-distance-field scenes
-
-usage:
-  sdfc render SCENE... -o OUT [--format F] [--width W] [--height H] [--samples N] [--time T]
-              [--frames A:B --fps F] [--aov depth,normal,steps] [--view steps]
-              [--threads N] [--camera-position X,Y,Z] [--camera-target X,Y,Z] [--fov DEG] [--quiet]
-              [--max-steps N] [--max-bounces N] [--max-distance D] [--epsilon E] [--shadows on|off]
-              [--ao on|off] [--aa grid|cone] [--exposure E] [--tonemap none|reinhard|aces]
-              (render(...)'s settings; also for bench)
-              OUT may contain {frame:04d} (or {frame}) and {name} (the scene's file stem)
-  sdfc glsl    SCENE [--target shadertoy|glsl330|html] [-o OUT]
-  sdfc compile SCENE --emit ast|ir|bytecode
-  sdfc check   SCENE
-  sdfc eval    SCENE (--at X,Y,Z | --points FILE) [--time T]
-  sdfc slice   SCENE --axis x|y|z --at V -o OUT [--format F] [--range UMIN,UMAX,VMIN,VMAX] [--width W] [--height H]
-  sdfc mesh    SCENE -o OUT.stl|obj|ply|3mf [--format F] [--resolution N | --cell SIZE] [--bounds X0,Y0,Z0,X1,Y1,Z1]
-              [--simplify TOL] [--time T] [--threads N] [--max-triangles N] [--max-cells N] [--error] [--quiet]
-              dual contouring: closed, sharp-edged; OBJ, PLY and 3MF carry the materials' colours;
-              --simplify: fewer triangles, all within TOL of the surface;
-              --error prints |distance| at the vertices and the triangles' centroids, in cells
-  sdfc bench   SCENE [--width W] [--height H] [--samples N] [--repeat N] [--threads N] [--baseline]
-              prints median_ms, min_ms, evals_per_pixel (SDF evaluations: rays, normals,
-              shadows, ao), shading (material evaluations), the mean program length run
-              (tape=MEAN/FULL) and the tape tree; --baseline: plain Hart sphere tracing
-  sdfc watch   [--runs N] [--debounce MS] CMD ARGS...
-              runs the command (render, glsl, check, slice, mesh, eval, compile) again on every
-              save of its scene or of a file it imports; the last good output stays
-  sdfc --help | --version | CMD --help
-
-SCENE is a .sdf script or a .vm model (Prospero/Fidget flat SSA format); - reads a script
-from standard input (its imports relative to the working folder). -o - writes to standard
-output: render, slice and mesh then take --format (png, exr, ...; stl, obj, ply, 3mf).
-Safety limits (defaults in docs/language.md): --max-recursion N, --max-iterations N,
---max-calls N, --max-shapes N, --max-shape-depth N, --max-ops N, --max-file-size BYTES,
---max-pixels N (width*height*samples), --max-frames N, --max-nesting N.
-Every command: -D NAME=VALUE sets the script's top-level `let NAME` to VALUE (an
-expression: -D size=2, -D 'tint=[1, 0, 0]'), as OpenSCAD's -D does.
-)";
 
 // --format: the image format of standard output (-o -); a file's extension names its own.
 std::string image_format_flag(const std::string& out, const std::optional<std::string>& format) {
@@ -529,27 +491,35 @@ int cmd_bench(Args& a) {
     return 0;
 }
 
-// `sdfc CMD --help`: the command's lines of the usage text and the notes after them (the
-// whole text for an unknown command).
-std::string command_usage(const std::string& cmd) {
-    const std::string text = kUsage, head = "  sdfc " + cmd + " ";
-    const size_t at = text.find(head);
-    if (at == std::string::npos || cmd.empty()) return text;
-    size_t end = text.find("\n  sdfc ", at + head.size());
-    const size_t notes = text.find("\n\n", at);
-    if (end == std::string::npos || (notes != std::string::npos && notes < end)) end = notes;
-    std::string out = "usage:\n" + text.substr(at, end - at + 1);
-    if (notes != std::string::npos) out += text.substr(notes + 1);
-    return out;
+// `sdfc help [CMD | --man | --completion SHELL]`.
+int cmd_help(Args& a) {
+    a.declare(option_names(*find_command("help")));
+    if (a.flag("--help") || a.flag("-h")) return write_stdout(command_help(*find_command("help"))), 0;
+    const bool man = a.flag("--man");
+    const auto shell = a.value("--completion");
+    const auto what = a.positionals();
+    if (man + bool(shell) + !what.empty() > 1) throw UsageError("help takes one of CMD, --man or --completion SHELL");
+    if (man) return write_stdout(man_page(SDFC_VERSION)), 0;
+    if (shell) {
+        const std::string script = completion_script(*shell);
+        if (script.empty()) throw UsageError(fmt::format("--completion takes bash or zsh, not '{}'", *shell));
+        return write_stdout(script), 0;
+    }
+    if (what.empty()) return write_stdout(global_help()), 0;
+    if (what.size() > 1) throw UsageError(fmt::format("help takes one command, got '{}' too", what[1]));
+    const CommandSpec* c = find_command(what[0]);
+    if (!c) throw UsageError(fmt::format("help: no command '{}' (see sdfc --help)", what[0]));
+    return write_stdout(command_help(*c)), 0;
 }
 
 int run_command(const std::vector<std::string>& all);
 
 int dispatch(const std::vector<std::string>& all) {
-    if (all.empty() || all[0] == "--help" || all[0] == "-h" || all[0] == "help") {
-        std::fputs(kUsage, all.empty() ? stderr : stdout);
-        return all.empty() ? 2 : 0;
+    if (all.empty()) {
+        std::fputs(global_help().c_str(), stderr);
+        return 2;
     }
+    if (all[0] == "--help" || all[0] == "-h") return write_stdout(global_help()), 0;
     if (all[0] == "--version") {
         std::printf("sdfc %s\n", SDFC_VERSION);
         return 0;
@@ -557,9 +527,10 @@ int dispatch(const std::vector<std::string>& all) {
     std::string cmd = all[0];
     if (cmd == "watch") return cmd_watch(std::vector<std::string>(all.begin() + 1, all.end()), run_command);
     Args a(std::vector<std::string>(all.begin() + 1, all.end()));
-    if (a.flag("--help") || a.flag("-h")) {
-        write_stdout(command_usage(cmd));
-        return 0;
+    if (cmd == "help") return cmd_help(a);
+    if (const CommandSpec* spec = find_command(cmd)) {
+        a.declare(option_names(*spec));
+        if (a.flag("--help") || a.flag("-h")) return write_stdout(command_help(*spec)), 0;
     }
     if (cmd == "render") return cmd_render(a);
     if (cmd == "check") return cmd_check(a);
@@ -569,7 +540,9 @@ int dispatch(const std::vector<std::string>& all) {
     if (cmd == "glsl") return cmd_glsl(a);
     if (cmd == "bench") return cmd_bench(a);
     if (cmd == "mesh") return cmd_mesh(a);
-    std::vector<std::string> cmds{"render", "glsl", "compile", "check", "eval", "slice", "bench", "mesh", "watch"};
+    if (cmd == "preview") return cmd_preview(a);
+    std::vector<std::string> cmds;
+    for (const CommandSpec& c : commands()) cmds.push_back(c.name);
     std::string near = nearest_name(cmd, cmds);
     throw UsageError(near.empty() ? fmt::format("unknown command '{}' (see sdfc --help)", cmd)
                                   : fmt::format("unknown command '{}' (did you mean `{}`?)", cmd, near));

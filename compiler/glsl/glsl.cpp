@@ -242,9 +242,10 @@ std::string header(const Parts& p, const char* target_line) {
 
 }  // namespace
 
-std::string emit_glsl(const Scene& scene, GlslTarget target, FieldSampler sample) {
+std::string emit_glsl(const Scene& scene, GlslTarget target, FieldSampler sample, bool* uses_time) {
     if (!scene.graph || !scene.root) throw CompileError(Loc{}, "internal: the scene has no graph");
     Parts p = generate(scene, sample);
+    if (uses_time) *uses_time = p.uses_time;
     switch (target) {
         case GlslTarget::Shadertoy: {
             std::string s = header(p,
@@ -277,7 +278,8 @@ std::string emit_glsl(const Scene& scene, GlslTarget target, FieldSampler sample
                  "}\n";
             return s;
         }
-        case GlslTarget::Html: {
+        case GlslTarget::Html:
+        case GlslTarget::HtmlShader: {
             std::string s = "#version 300 es\n";
             s += header(p, "// WebGL2 preview shader (GLSL ES 3.00): the Shadertoy code plus uniforms for the page's camera.\n\n");
             s += "precision highp float;\nprecision highp int;\n"
@@ -292,10 +294,13 @@ std::string emit_glsl(const Scene& scene, GlslTarget target, FieldSampler sample
                  "void main() {\n"
                  "    sdf_frag_color = sdf_render(gl_FragCoord.xy, iResolution.xy, iTime, uOrbit, uPan);\n"
                  "}\n";
+            if (target == GlslTarget::HtmlShader) return s;
             return glsl::html_page(p.name, s, p.uses_time);
         }
     }
     return {};
 }
+
+std::string html_live_page(const std::string& title) { return glsl::html_page(title, "", false, true); }
 
 }  // namespace sdfc

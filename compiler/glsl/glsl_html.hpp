@@ -27,8 +27,9 @@ inline std::string html_escape(std::string_view s) {
     return o;
 }
 
-// The page for `shader` (a complete GLSL ES 3.00 fragment shader starting with #version).
-inline std::string html_page(std::string_view title, std::string_view shader, bool uses_time) {
+// The page for `shader` (a complete GLSL ES 3.00 fragment shader starting with #version);
+// live: no shader, the page listens to sdfc preview's /events for them.
+inline std::string html_page(std::string_view title, std::string_view shader, bool uses_time, bool live = false) {
     std::string page(kPageHtml);
     auto put = [&](std::string_view key, std::string_view value) {
         size_t p = page.find(key);
@@ -37,6 +38,7 @@ inline std::string html_page(std::string_view title, std::string_view shader, bo
     put("@PAGE_JS@\n", kPageJs);  // first: the script holds @USES_TIME@
     put("@TITLE@", html_escape(title));
     put("@USES_TIME@", uses_time ? "true" : "false");
+    put("@LIVE@", live ? "true" : "false");
     put("@SHADER@", shader);  // last: the shader's text is not searched for keys
     return page;
 }

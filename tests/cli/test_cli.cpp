@@ -20,10 +20,10 @@ TEST_CASE("the flags --help and --version") {
     CHECK(v.out.rfind("sdfc ", 0) == 0);
     auto rh = run_sdfc("render --help");
     CHECK(rh.status == 0);
-    CHECK(rh.out.rfind("usage:\n  sdfc render SCENE...", 0) == 0);  // that command's lines only
+    CHECK(rh.out.rfind("usage: sdfc render SCENE... -o OUT [options]\n", 0) == 0);  // that command only
     CHECK(rh.out.find("sdfc glsl") == std::string::npos);
-    CHECK(rh.out.find("Safety limits") != std::string::npos);
-    CHECK(run_sdfc("mesh --help").out.rfind("usage:\n  sdfc mesh    SCENE -o OUT.stl|obj|ply|3mf", 0) == 0);
+    CHECK(rh.out.find("\nscene options (-D, and the safety limits: docs/language.md):\n") != std::string::npos);
+    CHECK(run_sdfc("mesh --help").out.rfind("usage: sdfc mesh SCENE -o OUT.stl|obj|ply|3mf [options]\n", 0) == 0);
     auto bad = run_sdfc("rendr x.sdf");
     CHECK(bad.status == 2);
     CHECK(bad.err == "sdfc: error: unknown command 'rendr' (did you mean `render`?)\n");
