@@ -251,6 +251,7 @@ std::string man_page(const std::string& version) {
     s += man_options(scene_options());
     s += ".SH \"EXIT STATUS\"\n0: done. 1: an error in the script or while working. 2: a bad command line.\n";
     s += ".SH ENVIRONMENT\n.TP\n.B SDFC_IMAGE_MODULE\nthe image library to load (libsdfc_image.so) instead of the one beside sdfc.\n";
+    s += ".TP\n.B SDFC_PREVIEW_MODULE\nthe preview's server library to load (libsdfc_preview.so) instead of the one beside sdfc.\n";
     s += ".SH \"SEE ALSO\"\nThe language: docs/language.md; the shapes and operations: docs/reference.md.\n";
     return s;
 }

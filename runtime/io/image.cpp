@@ -3,22 +3,16 @@
 // image start without OpenImageIO and its libraries.
 #include "runtime/io/image.hpp"
 
-#include <dlfcn.h>
-
-#include <cstdlib>
-#include <filesystem>
 #include <mutex>
 #include <stdexcept>
-#include <system_error>
-#include <vector>
+#include <string>
 
 #include "runtime/io/atomic_file.hpp"
 #include "runtime/io/image_backend.hpp"
+#include "runtime/io/module.hpp"
 
 namespace sdfc {
 namespace {
-
-namespace fs = std::filesystem;
 
 constexpr const char* kModule = "libsdfc_image.so";
 
@@ -31,16 +25,6 @@ constexpr const char* kModule = "libsdfc_image.so";
     reinterpret_cast<void (*)()>(&heat_color),     reinterpret_cast<void (*)()>(&aov_side_path),
 };
 
-// Next to the executable (the build folder; a test in build/tests finds it one up), or in
-// ../lib/sdfc beside an installed bin/; SDFC_IMAGE_MODULE names another.
-std::vector<fs::path> module_candidates() {
-    if (const char* forced = std::getenv("SDFC_IMAGE_MODULE"); forced && *forced) return {fs::path(forced)};
-    std::error_code ec;
-    const fs::path dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
-    if (ec || dir.empty()) return {fs::path(kModule)};  // the loader's own search
-    return {dir / kModule, dir.parent_path() / kModule, dir.parent_path() / "lib" / "sdfc" / kModule};
-}
-
 #ifdef SDFC_IMAGE_BUILTIN
 // Linked in (sanitizer and fuzz builds: CMakeLists.txt says why).
 const ImageBackend& backend() { return *sdfc_image_backend(); }
@@ -50,28 +34,14 @@ const ImageBackend& backend() {
     static std::string failure;
     static std::once_flag once;
     std::call_once(once, [] {
-        std::string tried;
-        for (const fs::path& p : module_candidates()) {
-            std::error_code ec;
-            if (p.has_parent_path() && !fs::exists(p, ec)) {
-                tried += (tried.empty() ? "" : ", ") + p.string();
-                continue;
-            }
-            void* h = dlopen(p.c_str(), RTLD_NOW | RTLD_LOCAL);
-            if (!h) {
-                failure = dlerror();
-                return;
-            }
-            auto entry = reinterpret_cast<const ImageBackend* (*)()>(dlsym(h, "sdfc_image_backend"));
-            const ImageBackend* b = entry ? entry() : nullptr;
-            if (!b || b->version != kImageBackendVersion) {
-                failure = p.string() + " is not this build's image module";
-                return;
-            }
-            loaded = b;
+        auto entry = reinterpret_cast<const ImageBackend* (*)()>(module_entry(kModule, "SDFC_IMAGE_MODULE", "sdfc_image_backend", failure));
+        if (!entry) return;
+        const ImageBackend* b = entry();
+        if (!b || b->version != kImageBackendVersion) {
+            failure = "it is not this build's image module";
             return;
         }
-        failure = "not found (looked for " + tried + ")";
+        loaded = b;
     });
     if (!loaded) throw std::runtime_error("cannot load the image library " + std::string(kModule) + ": " + failure);
     return *loaded;

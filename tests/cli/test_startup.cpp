@@ -1,5 +1,6 @@
 // Start-up (issue 15): image I/O is a module (libsdfc_image.so) opened at the first image
-// read or write, so the commands that write no image never load OpenImageIO.
+// read or write, so the commands that write no image never load OpenImageIO; the preview's
+// HTTP server is one too (libsdfc_preview.so).
 #include <catch2/catch.hpp>
 
 #include <filesystem>
@@ -23,6 +24,16 @@ TEST_CASE("the sdfc binary itself needs no OpenImageIO library") {
     CHECK(libs.find("libtbb") != std::string::npos);  // the list is real
     CHECK(libs.find("OpenImageIO") == std::string::npos);
     CHECK(libs.find("opencv") == std::string::npos);
+    // Nor the preview's HTTP server (libsdfc_preview.so) with its TLS and compression.
+    CHECK(libs.find("httplib") == std::string::npos);
+    CHECK(libs.find("libssl") == std::string::npos);
+}
+
+TEST_CASE("preview without its module says so before serving") {
+    const std::string s = test::write_temp("startup_preview.sdf", "sphere(1);\n");
+    auto r = run_sdfc("preview " + q(s) + " --port 0", "SDFC_PREVIEW_MODULE=/nonexistent/libsdfc_preview.so");
+    CHECK(r.status == 1);
+    CHECK(r.err == "sdfc: error: cannot load the preview server libsdfc_preview.so: not found (looked for /nonexistent/libsdfc_preview.so)\n");
 }
 
 TEST_CASE("commands that write no image run without the image module") {
