@@ -39,6 +39,10 @@ const std::vector<Layer>& layers() {
          {"runtime/eval", "runtime/io", "compiler/render", "compiler/bytecode", "compiler/scene", "compiler/ir",
           "compiler/base"}},
         {"runtime/mesh", {"runtime/eval", "runtime/io", "compiler/bytecode", "compiler/scene", "compiler/ir", "compiler/base"}},
+        // The public API (libsdfc.so) over every stage, as the command is.
+        {"runtime/api",
+         {"runtime/cpu", "runtime/mesh", "runtime/eval", "runtime/io", "compiler/glsl", "lang", "compiler/render",
+          "compiler/bytecode", "compiler/scene", "compiler/ir", "compiler/base"}},
     };
     return table;
 }
@@ -121,6 +125,26 @@ TEST_CASE("only the image module includes OpenImageIO (start-up without its libr
             INFO(rel << ": " << line);
             CHECK(line.find("#include <OpenImageIO/") == std::string::npos);
         }
+    }
+}
+
+TEST_CASE("only the preview server includes cpp-httplib (start-up without its libraries)", "[tree]") {
+    for (const std::string& rel : source_files()) {
+        if (!is_cxx(rel) || rel == "cli/preview/server.cpp" || rel.rfind("tests/", 0) == 0) continue;
+        for (const std::string& line : lines_of(rel)) {
+            INFO(rel << ": " << line);
+            CHECK(line.find("#include <httplib.h>") == std::string::npos);
+        }
+    }
+}
+
+TEST_CASE("the public header includes nothing of sdfc's or of its dependencies", "[tree]") {
+    const std::regex include_re(R"re(^\s*#\s*include\s+[<"]([^>"]+)[>"])re");
+    for (const std::string& line : lines_of("runtime/api/sdfc.hpp")) {
+        std::smatch m;
+        if (!std::regex_search(line, m, include_re)) continue;
+        INFO(line);
+        CHECK(std::string(m[1]).find_first_of("./") == std::string::npos);  // <string>, <vector>: the standard library
     }
 }
 
