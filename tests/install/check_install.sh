@@ -58,6 +58,15 @@ case "$flags" in *"-I$prefix/"*"include"*"-lsdfc"*) ;; *) fail "pkg-config sdfc 
 c++ -std=c++17 "$src/examples/embed/embed.cpp" -o "$work/embed-pc" $flags -Wl,-rpath,"$(dirname "$lib")" || fail "pkg-config build"
 "$work/embed-pc" "$work" | grep -qxF "error at broken.sdf:1:9: expected ')'" || fail "the pkg-config build does not run"
 
+# import sdfc from the installed tree (where the module was built): the Python tests again.
+py=$(find "$prefix" -name 'sdfc.cpython-*.so' | head -n 1)
+if [ -n "$py" ]; then
+  (cd "$work" && PYTHONPATH=$(dirname "$py") SDFC_SOURCE_DIR=$src /usr/bin/python3 -m pytest -q -p no:cacheprovider "$src/tests/python") \
+    || fail "the Python tests fail against the installed module"
+else
+  echo "check_install: no Python module in the build (pybind11 missing), not checked"
+fi
+
 # man sdfc, where man is installed.
 if command -v man >/dev/null; then
   MANPATH=$prefix/share/man MANWIDTH=100 man -P cat sdfc 2>/dev/null | grep -q 'sdfc - compile and render .sdf signed-distance-field scenes' \
