@@ -165,6 +165,7 @@ int cmd_render(Args& a) {
     bool quiet = a.flag("--quiet") || a.flag("-q");
     bool baseline = a.flag("--baseline");  // hidden: every acceleration off (issue 6)
     auto format = a.value("--format");
+    auto alpha = a.value("--alpha");
     // Overrides are read per scene below; take them out of the positionals first.
     Overrides ov;
     for (const char* f : kOverrideFlags) ov.emplace_back(f, a.value(f));
@@ -175,6 +176,17 @@ int cmd_render(Args& a) {
     RenderOptions ro;
     ro.baseline = baseline;
     if (threads) ro.threads = thread_count(*threads);
+    // Coverage as alpha: on for EXR unless --alpha off; --alpha on for the other formats that hold it.
+    std::string ext = fmt_ext.empty() ? std::filesystem::path(*out).extension().string() : "." + fmt_ext;
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+    ro.alpha = ext == ".exr";
+    if (alpha) {
+        if (*alpha != "on" && *alpha != "off") throw UsageError(fmt::format("--alpha takes on or off, not '{}'", *alpha));
+        ro.alpha = *alpha == "on";
+        const bool holds = ext == ".exr" || ext == ".png" || ext == ".tif" || ext == ".tiff" || ext == ".tga";
+        if (ro.alpha && !holds)
+            throw UsageError(fmt::format("--alpha on: {} has no alpha channel (exr, png, tif and tga have)", ext.empty() ? *out : ext.substr(1)));
+    }
     if (aov) {
         std::stringstream ss(*aov);
         for (std::string item; std::getline(ss, item, ',');) {

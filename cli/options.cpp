@@ -58,8 +58,12 @@ std::vector<CommandSpec> make_commands() {
                           {"--frames", "", "A:B", "", "", "frames A to B at --fps, time = --time + frame / fps"},
                           {"--fps", "", "F", "", "24", "frames per second of --frames"},
                           {"--aov", "", "LIST", "depth normal steps", "",
-                           "extra pictures, comma-separated: depth, normal, steps (EXR: channels; else side files OUT.NAME.EXT)"},
+                           "extra planes, comma-separated: depth, normal, steps; in EXR the channels Z (misses: +inf), N.x "
+                           "N.y N.z, steps.Y; else side files OUT.NAME.png (OUT.NAME.exr beside hdr or pfm)"},
                           {"--view", "", "shaded|steps", "shaded steps", "shaded", "steps: a heat map of the steps each ray took"},
+                          {"--alpha", "", "on|off", "on off", "on for exr, else off",
+                           "coverage as an alpha channel (exr, png, tif, tga); EXR colour is then premultiplied, 8-bit "
+                           "colour straight, and the background left out"},
                           threads,
                           quiet,
                           baseline,

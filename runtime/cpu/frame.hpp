@@ -28,6 +28,7 @@ struct Frame : RenderPlan {
     float time = 0.0f;
     bool has_distance = true, has_material = true;
     bool want_depth = false, want_normal = false, want_steps = false;
+    bool alpha = false;  // RenderOptions::alpha: the image has a coverage channel
     RenderView view = RenderView::Shaded;
     TapeTree tree;                  // leaf 0 (the full distance program) at least
     uint32_t max_regs = 1;          // registers of the longest distance tape: sizes the workers' VMs

@@ -9,6 +9,8 @@
 //  * AOVs: depth = first-hit distance (max_distance for misses; per pixel the minimum over
 //    samples), normal = unit world normal of the first hit (sample average, renormalised),
 //    steps = average primary-ray step count.
+//  * Alpha (RenderOptions::alpha): 1 minus the weight of the primary rays that missed; their
+//    background is then left out of the colour (premultiplied), bounces' misses stay in.
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC optimize("no-trapping-math")  // as in marcher.cpp
 #endif
@@ -29,6 +31,7 @@ void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* d
     prim_steps_.assign(nprim, 0.0f);
     prim_n_.assign(f_.want_normal ? nprim * 3 : 0, 0.0f);
     prim_aw_.assign(nprim, -1.0f);
+    miss_.assign(f_.alpha ? npix : 0, 0.0f);
     const float w0 = 1.0f / static_cast<float>(S);
     const glm::vec3 bg = f_.background;
 
@@ -67,6 +70,8 @@ void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* d
         if (hit_[r]) {
             hits_.push(O + D * t_[r], D, 0, 0, t_[r], glm::vec3(rest), static_cast<uint32_t>(r), false);
             if (rest > prim_aw_[r]) prim_aw_[r] = rest, prim_depth_[r] = t_[r];
+        } else if (f_.alpha) {
+            miss_[r / S] += rest;
         } else {
             add(static_cast<uint32_t>(r), bg * rest);
         }
@@ -96,6 +101,7 @@ void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* d
         for (int x = x0; x < x1; ++x) {
             const size_t p = static_cast<size_t>((y - y0) * tw + (x - x0));
             const size_t o = static_cast<size_t>(y) * img.width + x;
+            const size_t out = o * static_cast<size_t>(img.channels);
             float st = 0.0f, dmin = f_.max_dist;
             glm::vec3 nsum(0.0f);
             for (int s = 0; s < S; ++s) {
@@ -107,15 +113,17 @@ void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* d
             if (f_.view == RenderView::Steps) {
                 float rgb[3];
                 heat_color(st / static_cast<float>(std::max(f_.max_steps, 1)), rgb);
-                for (int c = 0; c < 3; ++c) img.pixels[o * 3 + c] = srgb_to_linear(rgb[c]);
+                for (int c = 0; c < 3; ++c) img.pixels[out + c] = srgb_to_linear(rgb[c]);
             } else {
                 for (int c = 0; c < 3; ++c) {
                     const float v = accum_[p * 3 + c];
                     const float r = v >= 0.0f ? std::min(v, 1e30f) : 0.0f;  // never NaN or inf
-                    img.pixels[o * 3 + c] = f_.exposure == 1.0f && f_.tonemap == 0 ? r : std::min(rules::sdf_tonemap1(r, f_.exposure, f_.tonemap), 1e30f);
+                    img.pixels[out + c] = f_.exposure == 1.0f && f_.tonemap == 0 ? r : std::min(rules::sdf_tonemap1(r, f_.exposure, f_.tonemap), 1e30f);
                 }
             }
-            if (depth) depth->data[o] = std::isfinite(dmin) ? dmin : f_.max_dist;
+            if (f_.alpha) img.pixels[out + 3] = f_.view == RenderView::Steps ? 1.0f : std::clamp(1.0f - miss_[p], 0.0f, 1.0f);
+            // A miss is marked: infinitely far (no real hit is at max_distance's value).
+            if (depth) depth->data[o] = dmin < f_.max_dist && std::isfinite(dmin) ? dmin : INFINITY;
             if (steps) steps->data[o] = st;
             if (normal) {
                 const float len = glm::length(nsum);

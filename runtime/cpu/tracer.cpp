@@ -130,7 +130,8 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
     glm::vec3 root_lo(0.0f), root_hi(0.0f);
     const bool want_tree = cpu::tree_root(f, scene, options, root_lo, root_hi);
 
-    Image img(f.width, f.height, 3);
+    f.alpha = options.alpha;
+    Image img(f.width, f.height, options.alpha ? 4 : 3);
     const AovSet aov(img, options.aovs);
     f.want_depth = aov.depth != nullptr;
     f.want_normal = aov.normal != nullptr;

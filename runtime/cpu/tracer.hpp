@@ -51,6 +51,10 @@ struct RenderOptions {
     int threads = 0;                // 0 = all hardware threads
     std::vector<std::string> aovs;  // any of "depth", "normal", "steps" (see AovPlane)
     RenderView view = RenderView::Shaded;
+    // A fourth channel, alpha: the pixel's coverage by the scene (primary rays that hit);
+    // the colour then leaves out the background where the scene does not cover the pixel
+    // (premultiplied by alpha, for compositing).
+    bool alpha = false;
     // Plain Hart sphere tracing on the full program: no tape tree (pruning, empty-space
     // skipping), no over-relaxation, no bounding-box clipping (`--baseline`, for measuring).
     bool baseline = false;

@@ -44,6 +44,7 @@ private:
     std::vector<uint8_t> hit_;
     std::vector<int> steps_;
     std::vector<float> prim_depth_, prim_steps_, prim_n_, prim_aw_;
+    std::vector<float> miss_;  // per pixel: the weight of its primary rays that missed (alpha)
     std::vector<float> ev_t_, ev_w_, trans_;
     std::vector<int> ev_n_;
     std::vector<uint32_t> local_, sh_idx_;

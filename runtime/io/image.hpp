@@ -1,9 +1,11 @@
 // Images: linear-light float pixels plus optional AOV planes, and their files.
 //
 // Files go through OpenImageIO; the format follows the extension. png/jpg/jpeg/tif/tiff/
-// bmp/tga/... are written as 8-bit sRGB; exr and hdr as linear float. EXR carries the AOVs
-// as extra channels (`Z`, `N.x N.y N.z`, `steps`); every other format gets visualised side
-// files `STEM.depth.png`, `STEM.normal.png`, `STEM.steps.png` next to the image.
+// bmp/tga/... are written as 8-bit sRGB; exr and hdr as linear float. A fourth channel is
+// alpha (A): premultiplied colour in float files, straight in 8-bit ones. EXR carries the
+// AOVs as extra channels (`Z`, `N.x N.y N.z`, `steps.Y`); every other format gets side
+// files next to the image: `STEM.depth.png`, `STEM.normal.png`, `STEM.steps.png`
+// (visualised), or beside a float hdr/pfm `STEM.NAME.exr` with the plane's own values.
 // Every file is encoded, decoded again as a check, and written by write_file
 // (runtime/io/atomic_file.hpp): a full disk, a crash or a kill never leaves a partial file,
 // an existing output is only replaced by a complete one, devices and FIFOs are written through.
@@ -14,8 +16,8 @@
 
 namespace sdfc {
 
-// An extra per-pixel plane: "depth" (1 channel, ray distance of the first hit, max_distance
-// for misses), "normal" (3, world-space unit normal of the first hit, 0 for misses), "steps"
+// An extra per-pixel plane: "depth" (1 channel, ray distance of the first hit, +inf for
+// misses), "normal" (3, world-space unit normal of the first hit, 0 for misses), "steps"
 // (1, sphere-tracing steps of the primary ray).
 struct AovPlane {
     std::string name;

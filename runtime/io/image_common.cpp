@@ -1,5 +1,6 @@
 // What images need without OpenImageIO: the sRGB encoding, the heat map, side-file names.
 // Built into sdfc_io and into the image module (runtime/io/oiio) alike.
+#include <cctype>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -33,7 +34,10 @@ void heat_color(float t, float rgb[3]) {
 
 std::string aov_side_path(const std::string& path, const std::string& aov) {
     fs::path p(path);
-    return (p.parent_path() / (p.stem().string() + "." + aov + ".png")).string();
+    std::string ext = p.extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const bool is_float = ext == ".exr" || ext == ".hdr" || ext == ".pfm";  // float pictures: float planes
+    return (p.parent_path() / (p.stem().string() + "." + aov + (is_float ? ".exr" : ".png"))).string();
 }
 
 }  // namespace sdfc

@@ -105,8 +105,12 @@ void write_atomic(const std::string& path, const std::string& as, int width, int
     OIIO::ImageSpec spec(width, height, static_cast<int>(names.size()), type);
     spec.channelnames = names;
     spec.alpha_channel = -1;
-    for (size_t i = 0; i < names.size(); ++i)
+    for (size_t i = 0; i < names.size(); ++i) {
         if (names[i] == "Z") spec.z_channel = static_cast<int>(i);
+        if (names[i] == "A") spec.alpha_channel = static_cast<int>(i);
+    }
+    // 8-bit files hold straight colour (unpremultiplied here first); float ones premultiplied.
+    if (spec.alpha_channel >= 0 && !linear) spec.attribute("oiio:UnassociatedAlpha", 1);
     spec.attribute("oiio:ColorSpace", linear ? "Linear" : "sRGB");
     spec.attribute("Software", "sdfc");
     auto encode = [&](OIIO::ImageOutput& out, const std::string& name, const std::string& temp) {
@@ -140,9 +144,29 @@ void write_atomic(const std::string& path, const std::string& as, int width, int
     write_file(path, std::string_view(reinterpret_cast<const char*>(buf.data()), buf.size()));
 }
 
+// An AOV plane's EXR channel names: Z, N.x N.y N.z, steps.Y (a layer of one channel).
+std::vector<std::string> aov_channel_names(const AovPlane& a) {
+    if (a.name == "depth" && a.channels == 1) return {"Z"};
+    if (a.name == "normal" && a.channels == 3) return {"N.x", "N.y", "N.z"};
+    if (a.channels == 1) return {a.name + ".Y"};
+    std::vector<std::string> names;
+    for (int c = 0; c < a.channels; ++c) names.push_back(a.name + "." + "xyzw"[c % 4]);
+    return names;
+}
+
+// A plane's value as stored: depth keeps +inf (a miss), anything else not finite is 0.
+float stored(const AovPlane& a, float v) { return a.name == "depth" && v == INFINITY ? v : finite_or_zero(v); }
+
 void write_side_file(const std::string& path, const Image& img, const AovPlane& a) {
     const size_t n = static_cast<size_t>(img.width) * img.height;
     if (a.data.size() < n * a.channels) throw std::runtime_error("cannot write '" + path + "': AOV '" + a.name + "' has the wrong size");
+    const std::string side = aov_side_path(path, a.name);
+    if (lower_ext(side) == ".exr") {  // next to a float picture: the plane's own values
+        std::vector<float> buf(n * size_t(a.channels));
+        for (size_t i = 0; i < buf.size(); ++i) buf[i] = stored(a, a.data[i]);
+        write_atomic(side, side, img.width, img.height, aov_channel_names(a), OIIO::TypeDesc::FLOAT, buf.data(), true);
+        return;
+    }
     std::vector<uint8_t> px;
     std::vector<std::string> names;
     if (a.name == "normal" && a.channels == 3) {
@@ -180,7 +204,6 @@ void write_side_file(const std::string& path, const Image& img, const AovPlane& 
             px[i] = to_u8(t);
         }
     }
-    const std::string side = aov_side_path(path, a.name);
     write_atomic(side, side, img.width, img.height, names, OIIO::TypeDesc::UINT8, px.data(), true);
 }
 
@@ -214,11 +237,7 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
         for (const auto& a : img.aovs) {
             if (a.data.size() < n * a.channels) throw std::runtime_error("cannot write '" + path + "': AOV '" + a.name + "' has the wrong size");
             planes.push_back(&a);
-            if (a.name == "depth" && a.channels == 1) names.push_back("Z");
-            else if (a.name == "normal" && a.channels == 3) names.insert(names.end(), {"N.x", "N.y", "N.z"});
-            else if (a.channels == 1) names.push_back(a.name);
-            else
-                for (int c = 0; c < a.channels; ++c) names.push_back(a.name + "." + "xyzw"[c % 4]);
+            for (const std::string& nm : aov_channel_names(a)) names.push_back(nm);
         }
         const size_t total = names.size();
         std::vector<float> buf(n * total);
@@ -227,7 +246,7 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
             for (int c = 0; c < nc; ++c) o[c] = finite_or_zero(img.pixels[i * img.channels + c]);
             size_t k = nc;
             for (const AovPlane* a : planes)
-                for (int c = 0; c < a->channels; ++c) o[k++] = finite_or_zero(a->data[i * a->channels + c]);
+                for (int c = 0; c < a->channels; ++c) o[k++] = stored(*a, a->data[i * a->channels + c]);
         }
         write_atomic(path, as, img.width, img.height, names, OIIO::TypeDesc::FLOAT, buf.data(), true);
         return;
@@ -244,6 +263,7 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
     std::vector<std::string> names(kRGBA, kRGBA + oc);
     if (oc == 1) names = {"Y"};
     if (is_float_format(ext)) {
+        if (nc == 4) throw std::runtime_error("cannot write '" + path + "': " + ext.substr(1) + " has no alpha channel (use exr or png)");
         const int fc = ext == ".hdr" ? 3 : oc;  // RGBE is always RGB
         std::vector<std::string> fnames(kRGBA, kRGBA + fc);
         std::vector<float> buf(n * fc);
@@ -255,13 +275,17 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
         write_atomic(path, as, img.width, img.height, fnames, OIIO::TypeDesc::FLOAT, buf.data(), true);
         return;
     }
-    // 8-bit, sRGB-encoded colour; alpha stays linear.
+    // 8-bit, sRGB-encoded colour; alpha stays linear, and the colour straight (not
+    // premultiplied by it), as PNG and the like hold it.
     std::vector<uint8_t> buf(n * oc);
-    for (size_t i = 0; i < n; ++i)
+    for (size_t i = 0; i < n; ++i) {
+        const float a = oc == 4 ? img.pixels[i * img.channels + 3] : 1.0f;
         for (int c = 0; c < oc; ++c) {
             float v = img.pixels[i * img.channels + c];
+            if (c < 3 && oc == 4) v = a > 0.0f ? v / a : 0.0f;
             buf[i * oc + c] = to_u8(c == 3 ? v : linear_to_srgb(v));
         }
+    }
     write_atomic(path, as, img.width, img.height, names, OIIO::TypeDesc::UINT8, buf.data(), false);
 }
 
@@ -287,7 +311,7 @@ Image oiio_read_image(const std::string& path) {
     for (int c = 0; c < nch; ++c) {
         const std::string nm = c < static_cast<int>(spec.channelnames.size()) ? spec.channelnames[c] : std::string();
         if (nm == "Z") z = c;
-        else if (nm == "steps") steps = c;
+        else if (nm == "steps.Y" || nm == "steps") steps = c;
         else if (nm == "N.x") nrm[0] = c;
         else if (nm == "N.y") nrm[1] = c;
         else if (nm == "N.z") nrm[2] = c;
