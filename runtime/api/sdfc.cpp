@@ -89,10 +89,13 @@ Error::Error(const std::string& what, std::vector<Diagnostic> diagnostics)
     : std::runtime_error(what), diagnostics_(std::move(diagnostics)) {}
 
 std::vector<std::uint8_t> Image::srgb8() const {
-    std::vector<std::uint8_t> out(rgb.size());
-    for (size_t i = 0; i < rgb.size(); ++i) {
-        const float v = std::clamp(linear_to_srgb(rgb[i]), 0.0f, 1.0f);
-        out[i] = std::uint8_t(std::lround(v * 255.0f));
+    const size_t n = rgb.size() / 3, k = alpha.empty() ? 3 : 4;
+    auto byte = [](float v) { return std::uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); };
+    std::vector<std::uint8_t> out(n * k);
+    for (size_t p = 0; p < n; ++p) {
+        const float a = k == 4 ? alpha[p] : 1.0f;
+        for (size_t c = 0; c < 3; ++c) out[p * k + c] = byte(linear_to_srgb(k == 4 ? (a > 0.0f ? rgb[p * 3 + c] / a : 0.0f) : rgb[p * 3 + c]));
+        if (k == 4) out[p * k + 3] = byte(a);
     }
     return out;
 }
@@ -138,13 +141,18 @@ Image Scene::render(const RenderSettings& r) const {
     } else {
         RenderOptions ro;
         ro.threads = r.threads;
+        ro.alpha = r.alpha;
         img = sdfc::render(cs, ro);
     }
     Image out;
     out.width = img.width, out.height = img.height;
     out.rgb.resize(size_t(img.width) * img.height * 3);
-    for (size_t p = 0; p < size_t(img.width) * img.height; ++p)
-        for (int c = 0; c < 3; ++c) out.rgb[p * 3 + c] = img.pixels[p * img.channels + size_t(std::min(c, img.channels - 1))];
+    const bool with_alpha = r.alpha && img.channels == 4;
+    if (r.alpha) out.alpha.assign(size_t(img.width) * img.height, 1.0f);  // a 2D model covers everything
+    for (size_t p = 0; p < size_t(img.width) * img.height; ++p) {
+        for (int c = 0; c < 3; ++c) out.rgb[p * 3 + c] = img.pixels[p * img.channels + size_t(std::min(c, std::min(img.channels, 3) - 1))];
+        if (with_alpha) out.alpha[p] = img.pixels[p * 4 + 3];
+    }
     return out;
 }
 

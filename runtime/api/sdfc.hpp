@@ -47,14 +47,18 @@ struct Options {
 
 struct SDFC_API Image {
     int width = 0, height = 0;
-    std::vector<float> rgb;  // linear RGB, 3 floats a pixel, row 0 at the top
-    // The picture as 8-bit sRGB, 3 bytes a pixel (clipped to [0, 1], encoded, rounded).
+    std::vector<float> rgb;    // linear RGB, 3 floats a pixel, row 0 at the top
+    std::vector<float> alpha;  // coverage, a float a pixel (RenderSettings::alpha; else empty);
+                               // rgb is then premultiplied by it (the background left out)
+    // The picture as 8-bit sRGB, 3 bytes a pixel (clipped to [0, 1], encoded, rounded; with
+    // alpha, 4: the colour straight, divided by alpha, as PNG holds it).
     std::vector<std::uint8_t> srgb8() const;
 };
 
 struct RenderSettings {
     int width = 0, height = 0, samples = 0;  // 0: the script's render(...) (else 640 x 480, 1)
     int threads = 0;                         // 0: every hardware thread
+    bool alpha = false;                      // coverage in Image::alpha
 };
 
 struct MeshSettings {

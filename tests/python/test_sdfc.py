@@ -57,6 +57,9 @@ def test_render_a_file_to_numpy():
     assert img.max() > 0.1 and np.isfinite(img).all()
     same = sdfc.compile(str(SOURCE / "examples" / "three-tori.sdf")).render(width=64, height=36)
     np.testing.assert_array_equal(img, same)  # a str path is a path too
+    rgba = s.render(width=64, height=36, alpha=True)
+    assert rgba.shape == (36, 64, 4)
+    assert 0 <= rgba[..., 3].min() and rgba[..., 3].max() == 1
     with pytest.raises(ValueError, match="render: width and height"):
         s.render(width=20000)
 

@@ -111,14 +111,19 @@ py::array_t<float> eval_points(const PyScene& s, const py::array_t<float, py::ar
     return out;
 }
 
-py::array_t<float> render(const PyScene& s, int width, int height, int samples, int threads) {
-    RenderSettings rs{width, height, samples, threads};
+py::array_t<float> render(const PyScene& s, int width, int height, int samples, int threads, bool alpha) {
+    RenderSettings rs{width, height, samples, threads, alpha};
     Image img = translated([&] {
         py::gil_scoped_release unlocked;
         return s.scene.render(rs);
     });
-    py::array_t<float> out({py::ssize_t(img.height), py::ssize_t(img.width), py::ssize_t(3)});
-    std::memcpy(out.mutable_data(), img.rgb.data(), img.rgb.size() * sizeof(float));
+    const size_t k = alpha ? 4 : 3, n = size_t(img.width) * img.height;
+    py::array_t<float> out({py::ssize_t(img.height), py::ssize_t(img.width), py::ssize_t(k)});
+    float* o = out.mutable_data();
+    for (size_t p = 0; p < n; ++p) {
+        for (size_t c = 0; c < 3; ++c) o[p * k + c] = img.rgb[p * 3 + c];
+        if (alpha) o[p * k + 3] = img.alpha[p];
+    }
     return out;
 }
 
@@ -196,7 +201,9 @@ PYBIND11_MODULE(sdfc, m) {
             "The script's warnings, as dicts (file, line, column, severity, message, text).")
         .def("eval", &eval_points, py::arg("points"), "Signed distances at an (N, 3) array of points: an (N,) float32 array.")
         .def("render", &render, py::kw_only(), py::arg("width") = 0, py::arg("height") = 0, py::arg("samples") = 0,
-             py::arg("threads") = 0, "The picture as an (H, W, 3) float32 array of linear RGB (0: the script's settings).")
+             py::arg("threads") = 0, py::arg("alpha") = false,
+             "The picture as an (H, W, 3) float32 array of linear RGB (0: the script's settings); alpha=True: (H, W, 4), "
+             "RGB premultiplied by the coverage A.")
         .def("glsl", [](const PyScene& s, const std::string& target) { return translated([&] { return s.scene.glsl(target); }); },
              py::arg("target") = "shadertoy", "The scene as GLSL: 'shadertoy', 'glsl330' or 'html' (a WebGL2 page).")
         .def("mesh", &mesh, py::kw_only(), py::arg("resolution") = 256, py::arg("simplify") = 0.0f, py::arg("colors") = false,
