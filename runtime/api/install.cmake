@@ -28,3 +28,7 @@ install(FILES ${CMAKE_BINARY_DIR}/sdfc.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pk
 install(FILES ${SDFC_SHARE}/man/man1/sdfc.1 DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
 install(FILES ${SDFC_SHARE}/bash-completion/completions/sdfc DESTINATION ${CMAKE_INSTALL_DATADIR}/bash-completion/completions)
 install(FILES ${SDFC_SHARE}/zsh/site-functions/_sdfc DESTINATION ${CMAKE_INSTALL_DATADIR}/zsh/site-functions)
+# The editor grammar (TextMate: VS Code, Sublime Text, GitHub) and the VS Code extension
+# folder that uses it (its package.json finds the grammar one folder up).
+install(FILES grammar/sdf.tmLanguage.json DESTINATION ${CMAKE_INSTALL_DATADIR}/sdfc/editors)
+install(DIRECTORY grammar/vscode DESTINATION ${CMAKE_INSTALL_DATADIR}/sdfc/editors)

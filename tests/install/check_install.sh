@@ -13,7 +13,8 @@ fail() { echo "check_install: $*" >&2; exit 1; }
 
 cmake --install "$build" --prefix "$prefix" >"$work/install.log" || { cat "$work/install.log"; fail "cmake --install failed"; }
 for f in bin/sdfc lib/sdfc/libsdfc_image.so lib/sdfc/libsdfc_preview.so include/sdfc/sdfc.hpp \
-         share/man/man1/sdfc.1 share/bash-completion/completions/sdfc share/zsh/site-functions/_sdfc; do
+         share/man/man1/sdfc.1 share/bash-completion/completions/sdfc share/zsh/site-functions/_sdfc \
+         share/sdfc/editors/sdf.tmLanguage.json share/sdfc/editors/vscode/package.json; do
   [ -f "$prefix/$f" ] || fail "not installed: $f"
 done
 lib=$(find "$prefix" -name 'libsdfc.so' | head -n 1)
