@@ -84,7 +84,7 @@ TEST_CASE("EXR: R G B A Z N.x N.y N.z steps.Y, a miss at Z = +inf", "[image][alp
     fs::remove_all(dir);
 }
 
-TEST_CASE("8-bit files hold straight colour with alpha; hdr has none; its side files are float", "[image][alpha]") {
+TEST_CASE("8-bit files hold straight colour with alpha, hdr has none, its side files are float", "[image][alpha]") {
     const fs::path dir = dir_for("png");
     auto c = test::compile_text(kScene);
     RenderOptions o;
