@@ -26,8 +26,9 @@ def test_eval_on_numpy_points():
 def test_defines_and_time():
     s = sdfc.compile("let r = 1;\nsphere(r + time);", defines={"r": 2}, time=0.5)
     assert s.eval(np.zeros((1, 3)))[0] == pytest.approx(-2.5)
-    v = sdfc.compile("let c = [0, 0, 0];\ntranslate(c) sphere(1);", defines={"c": [3, 0, 0]})
-    assert v.eval(np.array([[3, 0, 0]]))[0] == pytest.approx(-1)
+    for c in ([3, 0, 0], (3, 0, 0), np.array([3.0, 0, 0]), "[1 + 2, 0, 0]"):
+        v = sdfc.compile("let c = [0, 0, 0];\ntranslate(c) sphere(1);", defines={"c": c})
+        assert v.eval(np.array([[3, 0, 0]]))[0] == pytest.approx(-1)
 
 
 def test_compile_error_carries_file_line_column():

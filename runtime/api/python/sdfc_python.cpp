@@ -51,15 +51,23 @@ struct PyScene {
     Scene scene;
 };
 
+// A -D value as the language writes it: a str is taken as an expression; booleans, numbers
+// and lists or tuples of them (numpy's too) are written out.
+std::string expression_of(const py::handle& v) {
+    if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+    if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
+    if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v) || py::isinstance<py::array>(v)) {
+        std::string out = "[";
+        for (const py::handle& item : v) out += (out.size() > 1 ? ", " : "") + expression_of(item);
+        return out + "]";
+    }
+    return py::str(v).cast<std::string>();
+}
+
 Options options_of(float time, const std::map<std::string, py::object>& defines) {
     Options o;
     o.time = time;
-    for (const auto& [name, value] : defines) {
-        // -D takes an expression: numbers and lists of numbers are written as the language reads them.
-        std::string text = py::isinstance<py::str>(value) ? value.cast<std::string>() : py::str(value).cast<std::string>();
-        if (py::isinstance<py::bool_>(value)) text = value.cast<bool>() ? "true" : "false";
-        o.defines.emplace_back(name, text);
-    }
+    for (const auto& [name, value] : defines) o.defines.emplace_back(name, expression_of(value));
     return o;
 }
 
@@ -76,10 +84,11 @@ PyScene compile(const py::object& source, std::optional<std::string> name, float
         const bool ext = s.size() > 4 && (s.compare(s.size() - 4, 4, ".sdf") == 0 || s.compare(s.size() - 3, 3, ".vm") == 0);
         if (one_line && ext) path = s;
     }
+    const std::string text = path ? std::string() : source.cast<std::string>();  // with the GIL held
     Scene scene;
     {
         py::gil_scoped_release unlocked;
-        scene = path ? compile_file(*path, o) : compile_string(source.cast<std::string>(), name.value_or("<string>"), o);
+        scene = path ? compile_file(*path, o) : compile_string(text, name.value_or("<string>"), o);
     }
     if (!scene.ok()) raise_compile_error(scene.diagnostics(), "the scene did not compile");
     return PyScene{scene};
