@@ -39,6 +39,18 @@ double progress_after_s();
 // `label` ("frame 3/24") goes after the percentage.
 void progress_line(const std::string& target, double frac, double elapsed_s, double eta, const std::string& label = "");
 
+// This task's share of a batch (batch.cpp): items k with k % count == index.
+struct Shard {
+    int index = 0, count = 1;
+    std::string from;  // the scheduler's variable it came from, or ""
+};
+// --shard I/N, --shard auto (Slurm's SLURM_ARRAY_TASK_*, Kubernetes' JOB_COMPLETION_INDEX with
+// SDFC_SHARD_COUNT), or with no flag the scheduler's when a batch of `items` has several.
+Shard read_shard(const std::optional<std::string>& flag, size_t items);
+// --tiles I/N: band I of N, or nothing.
+std::optional<std::pair<int, int>> read_bands(const std::optional<std::string>& flag);
+int cmd_merge(Args& a);
+
 int cmd_mesh(Args& a);
 // `sdfc preview` (preview_command.cpp): serves the live page until Ctrl-C.
 int cmd_preview(Args& a);

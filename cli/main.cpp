@@ -166,6 +166,9 @@ int cmd_render(Args& a) {
     bool baseline = a.flag("--baseline");  // hidden: every acceleration off (issue 6)
     auto format = a.value("--format");
     auto alpha = a.value("--alpha");
+    auto shard_s = a.value("--shard");
+    auto tiles = a.value("--tiles");
+    const bool skip_existing = a.flag("--skip-existing");
     // Overrides are read per scene below; take them out of the positionals first.
     Overrides ov;
     for (const char* f : kOverrideFlags) ov.emplace_back(f, a.value(f));
@@ -179,7 +182,12 @@ int cmd_render(Args& a) {
     // Coverage as alpha: on for EXR unless --alpha off; --alpha on for the other formats that hold it.
     std::string ext = fmt_ext.empty() ? std::filesystem::path(*out).extension().string() : "." + fmt_ext;
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
-    ro.alpha = ext == ".exr";
+    const auto bands = read_bands(tiles);
+    if (bands) {
+        if (ext != ".exr") throw UsageError("--tiles writes a band of the picture as exr (for sdfc merge): -o PART.exr");
+        ro.band = bands->first, ro.bands = bands->second;
+    }
+    ro.alpha = ext == ".exr" && !bands;  // a band holds what the merged picture will: alpha if asked
     if (alpha) {
         if (*alpha != "on" && *alpha != "off") throw UsageError(fmt::format("--alpha takes on or off, not '{}'", *alpha));
         ro.alpha = *alpha == "on";
@@ -220,6 +228,15 @@ int cmd_render(Args& a) {
     }
     if (scenes.size() > 1 && out->find("{name}") == std::string::npos)
         throw UsageError("rendering several scenes needs {name} in the output name");
+    const size_t items = scenes.size() * size_t(f1 - f0 + 1);
+    if (bands && items > 1) throw UsageError("--tiles renders one band of one picture: give one scene and one frame");
+    const Shard shard = read_shard(shard_s, items);
+    // Item k (the scenes' frames in order) is this task's when k % count == index.
+    auto mine = [&](size_t scene, int f) { return (scene * size_t(f1 - f0 + 1) + size_t(f - f0)) % size_t(shard.count) == size_t(shard.index); };
+    size_t my_items = 0;
+    for (size_t k = 0; k < items; ++k) my_items += k % size_t(shard.count) == size_t(shard.index);
+    if (!shard.from.empty() && !quiet)
+        std::fprintf(stderr, "sdfc: shard %d/%d (%s): %zu of %zu pictures\n", shard.index, shard.count, shard.from.c_str(), my_items, items);
     if (*out == "-" && !ro.aovs.empty() && fmt_ext != "exr")
         throw UsageError("--aov to standard output needs --format exr (as channels: side files need a file name)");
     // The outputs can be written (folder, format, not a directory...) before any work.
@@ -250,24 +267,46 @@ int cmd_render(Args& a) {
     };
     // With several outputs, every frame of every scene compiles before the first image is
     // written: an error at any frame leaves no output at all (LANGUAGE.md section 9).
-    if (f1 > f0 || scenes.size() > 1)
-        for (const std::string& path : scenes)
+    // A picture already there is complete (written whole or not at all): --skip-existing
+    // leaves it (a re-run task, a farm's retry).
+    auto present = [&](const std::string& target) {
+        std::error_code ec;
+        if (target == "-" || !std::filesystem::is_regular_file(target, ec)) return false;
+        if (!is_exr(target))
+            for (const std::string& av : ro.aovs)
+                if (!std::filesystem::is_regular_file(aov_side_path(target, av), ec)) return false;
+        return true;
+    };
+    auto todo = [&](size_t scene, int f) {
+        return mine(scene, f) && !(skip_existing && present(expand(*out, f, std::filesystem::path(scenes[scene]).stem().string())));
+    };
+    if (my_items > 1)
+        for (size_t i = 0; i < scenes.size(); ++i)
             for (int f = f0; f <= f1; ++f) {
+                if (!todo(i, f)) continue;
                 SourceManager sm;
-                (void)compile_frame(sm, path, f);
+                (void)compile_frame(sm, scenes[i], f);
             }
     // One bar for the whole batch (frames of several scenes): "frame 3/24", the ETA of all.
-    const int total = int(scenes.size()) * (f1 - f0 + 1);
+    int total = 0;
+    for (size_t i = 0; i < scenes.size(); ++i)
+        for (int f = f0; f <= f1; ++f) total += todo(i, f);
     const auto batch_t0 = std::chrono::steady_clock::now();
     int done = 0;
     bool bar = false;  // drawn: cleared before the next summary line
     const bool tty = !quiet && isatty(fileno(stderr));
-    for (const std::string& path : scenes) {
+    for (size_t scene = 0; scene < scenes.size(); ++scene) {
+        const std::string& path = scenes[scene];
         std::string name = std::filesystem::path(path).stem().string();
         for (int f = f0; f <= f1; ++f) {
+            if (!mine(scene, f)) continue;
+            std::string target = expand(*out, f, name);
+            if (skip_existing && present(target)) {
+                if (!quiet) std::fprintf(stderr, "sdfc: skipped %s (it is there)\n", target.c_str());
+                continue;
+            }
             SourceManager sm;
             CompiledScene cs = compile_frame(sm, path, f);
-            std::string target = expand(*out, f, name);
             check_not_input(target, sm);
             if (!is_exr(target) && target != "-")
                 for (const std::string& av : ro.aovs) check_not_input(aov_side_path(target, av), sm);
@@ -553,6 +592,7 @@ int dispatch(const std::vector<std::string>& all) {
     if (cmd == "bench") return cmd_bench(a);
     if (cmd == "mesh") return cmd_mesh(a);
     if (cmd == "preview") return cmd_preview(a);
+    if (cmd == "merge") return cmd_merge(a);
     std::vector<std::string> cmds;
     for (const CommandSpec& c : commands()) cmds.push_back(c.name);
     std::string near = nearest_name(cmd, cmds);

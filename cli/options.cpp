@@ -64,6 +64,12 @@ std::vector<CommandSpec> make_commands() {
                           {"--alpha", "", "on|off", "on off", "on for exr, else off",
                            "coverage as an alpha channel (exr, png, tif, tga); EXR colour is then premultiplied, 8-bit "
                            "colour straight, and the background left out"},
+                          {"--shard", "", "I/N|auto", "", "the scheduler's, for a batch",
+                           "render the pictures k (the scenes' frames in order) with k mod N = I; auto: I and N from a Slurm "
+                           "job array (SLURM_ARRAY_TASK_ID, _MIN, _COUNT) or a Kubernetes Indexed Job (JOB_COMPLETION_INDEX, "
+                           "and SDFC_SHARD_COUNT for N); 0/1: all"},
+                          {"--skip-existing", "", "", "", "", "leave pictures that are there already (they are written whole or not at all)"},
+                          {"--tiles", "", "I/N", "", "", "render band I of N (rows of whole tiles) into a partial EXR, for sdfc merge"},
                           threads,
                           quiet,
                           baseline,
@@ -122,6 +128,13 @@ std::vector<CommandSpec> make_commands() {
                      quiet,
                  },
                  "", true});
+    c.push_back({"merge", "PART.exr... -o OUT", "put the bands of render --tiles together: the picture one render makes",
+                 {
+                     {"--output", "-o", "OUT", "FILE", "", "the picture (any format render writes); - is standard output (needs --format)"},
+                     {"--format", "", "F", kImageFormats, "", "the image format of standard output (-o -)"},
+                     quiet,
+                 },
+                 "The bands may come in any order; together they must cover the picture's rows once.", false});
     c.push_back({"bench", "SCENE", "time renders of the scene",
                  with({
                           {"--repeat", "", "N", "", "5", "renders timed"},

@@ -22,7 +22,7 @@
 namespace sdfc::cpu {
 
 
-void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* depth, AovPlane* normal, AovPlane* steps) {
+void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* depth, AovPlane* normal, AovPlane* steps, int row0) {
     const int tw = x1 - x0, th = y1 - y0;
     const int S = f_.samples;
     const size_t npix = static_cast<size_t>(tw) * th, nprim = npix * S;
@@ -100,7 +100,7 @@ void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* d
     for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
             const size_t p = static_cast<size_t>((y - y0) * tw + (x - x0));
-            const size_t o = static_cast<size_t>(y) * img.width + x;
+            const size_t o = static_cast<size_t>(y - row0) * img.width + x;
             const size_t out = o * static_cast<size_t>(img.channels);
             float st = 0.0f, dmin = f_.max_dist;
             glm::vec3 nsum(0.0f);

@@ -131,7 +131,18 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
     const bool want_tree = cpu::tree_root(f, scene, options, root_lo, root_hi);
 
     f.alpha = options.alpha;
-    Image img(f.width, f.height, options.alpha ? 4 : 3);
+    const bool band = options.bands > 0;
+    int row0 = 0, row1 = f.height;
+    if (band) {
+        const int tile_rows = (f.height + f.tile - 1) / f.tile;
+        if (options.band < 0 || options.band >= options.bands || options.bands > tile_rows)
+            throw std::invalid_argument("band " + std::to_string(options.band) + " of " + std::to_string(options.bands) + ": the picture has " +
+                                        std::to_string(tile_rows) + " rows of tiles (" + std::to_string(f.tile) + " pixels each)");
+        row0 = int(int64_t(options.band) * tile_rows / options.bands) * f.tile;
+        row1 = std::min(int(int64_t(options.band + 1) * tile_rows / options.bands) * f.tile, f.height);
+    }
+    Image img(f.width, row1 - row0, options.alpha ? 4 : 3);
+    if (band) img.row0 = row0, img.full_height = f.height;
     const AovSet aov(img, options.aovs);
     f.want_depth = aov.depth != nullptr;
     f.want_normal = aov.normal != nullptr;
@@ -152,10 +163,10 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
     });
 
     tbb::enumerable_thread_specific<std::unique_ptr<cpu::Worker>> workers;
-    for_each_tile(arena, f.width, f.height, f.tile, options.progress, start, [&](int x0, int y0, int x1, int y1) {
+    for_each_tile(arena, f.width, row1 - row0, f.tile, options.progress, start, [&](int x0, int y0, int x1, int y1) {
         std::unique_ptr<cpu::Worker>& w = workers.local();
         if (!w) w = std::make_unique<cpu::Worker>(f);
-        w->render_tile(x0, y0, x1, y1, img, aov.depth, aov.normal, aov.steps);
+        w->render_tile(x0, y0 + row0, x1, y1 + row0, img, aov.depth, aov.normal, aov.steps, row0);
     });
 
     if (stats) {

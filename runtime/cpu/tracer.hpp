@@ -55,6 +55,10 @@ struct RenderOptions {
     // the colour then leaves out the background where the scene does not cover the pixel
     // (premultiplied by alpha, for compositing).
     bool alpha = false;
+    // Band `band` of `bands` (bands 0: the whole picture): the rows of tiles split in `bands`
+    // runs as even as whole tiles allow. The image is that band (Image::row0 and full_height
+    // say where it goes) and its pixels are exactly the whole picture's (sdfc render --tiles).
+    int band = 0, bands = 0;
     // Plain Hart sphere tracing on the full program: no tape tree (pruning, empty-space
     // skipping), no over-relaxation, no bounding-box clipping (`--baseline`, for measuring).
     bool baseline = false;

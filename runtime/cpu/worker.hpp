@@ -28,7 +28,8 @@ public:
     }
 
     // Pixels [x0, x1) x [y0, y1) of img and of the AOV planes that are not null (tile.cpp).
-    void render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* depth, AovPlane* normal, AovPlane* steps);
+    // Pixels (x, y) go to row y - row0 of img and the planes (a band of the picture).
+    void render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* depth, AovPlane* normal, AovPlane* steps, int row0 = 0);
 
     RenderStats stats;
 

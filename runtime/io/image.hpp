@@ -27,6 +27,9 @@ struct AovPlane {
 
 struct Image {
     int width = 0, height = 0, channels = 3;
+    // A band of a taller picture (sdfc render --tiles): its first row there, and that
+    // picture's height; 0 and 0 for a whole picture. Written as an EXR data window.
+    int row0 = 0, full_height = 0;
     std::vector<float> pixels;  // linear RGB (channels interleaved), row-major, row 0 at the top
     std::vector<AovPlane> aovs;
 

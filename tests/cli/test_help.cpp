@@ -50,7 +50,7 @@ TEST_CASE("every command's --help lists its options with their defaults") {
     const std::regex line("\n  sdfc ([a-z]+) ");
     for (auto it = std::sregex_iterator(top.out.begin(), top.out.end(), line); it != std::sregex_iterator(); ++it)
         cmds.push_back((*it)[1]);
-    CHECK(cmds == std::vector<std::string>{"render", "glsl", "compile", "check", "eval", "slice", "mesh", "bench", "watch", "preview", "help"});
+    CHECK(cmds == std::vector<std::string>{"render", "glsl", "compile", "check", "eval", "slice", "mesh", "merge", "bench", "watch", "preview", "help"});
     for (const std::string& c : cmds) {
         INFO(c);
         const auto h = run_sdfc(c + " --help");
@@ -88,7 +88,7 @@ TEST_CASE("the man page documents every command and option") {
     const auto man = run_sdfc("help --man");
     REQUIRE(man.status == 0);
     CHECK(man.out.find(".TH SDFC 1 ") != std::string::npos);
-    for (const char* c : {"render", "glsl", "compile", "check", "eval", "slice", "mesh", "bench", "watch", "preview"})
+    for (const char* c : {"render", "glsl", "compile", "check", "eval", "slice", "mesh", "merge", "bench", "watch", "preview"})
         CHECK(man.out.find(std::string(".SS \"sdfc ") + c + " ") != std::string::npos);
     CHECK(man.out.find(".TP\n\\fB\\-\\-width\\fR \\fIW\\fR\npicture width in pixels (default: 640).\n") != std::string::npos);
     CHECK(man.out.find("\\fB\\-D\\fR \\fINAME=VALUE\\fR") != std::string::npos);

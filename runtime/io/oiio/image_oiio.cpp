@@ -99,10 +99,16 @@ void verify_file(const std::string& path, const std::string& file, int width, in
 // In memory where the format's writer takes an IOProxy; otherwise through a temporary
 // file in the system's temporary folder, read back.
 // `as` names the format (the path itself, or "stdout.png" for standard output).
+// `row0` and `full_height` (> 0): the image is that band of a taller picture, written as
+// the EXR data window inside that picture's display window.
 void write_atomic(const std::string& path, const std::string& as, int width, int height, const std::vector<std::string>& names,
-                  OIIO::TypeDesc type, const void* data, bool linear) {
+                  OIIO::TypeDesc type, const void* data, bool linear, int row0 = 0, int full_height = 0) {
     if (width <= 0 || height <= 0) throw std::runtime_error(write_error(path, "the image is empty"));
     OIIO::ImageSpec spec(width, height, static_cast<int>(names.size()), type);
+    if (full_height > 0) {
+        spec.y = row0;
+        spec.full_x = 0, spec.full_y = 0, spec.full_width = width, spec.full_height = full_height;
+    }
     spec.channelnames = names;
     spec.alpha_channel = -1;
     for (size_t i = 0; i < names.size(); ++i) {
@@ -113,6 +119,9 @@ void write_atomic(const std::string& path, const std::string& as, int width, int
     if (spec.alpha_channel >= 0 && !linear) spec.attribute("oiio:UnassociatedAlpha", 1);
     spec.attribute("oiio:ColorSpace", linear ? "Linear" : "sRGB");
     spec.attribute("Software", "sdfc");
+    // No time of writing (OpenEXR's writer adds one unless told): the same picture is the
+    // same bytes, so a re-run render (a retried farm task) is byte-identical.
+    spec.attribute("DateTime", "");
     auto encode = [&](OIIO::ImageOutput& out, const std::string& name, const std::string& temp) {
         bool ok = out.open(name, spec) && out.write_image(type, data);
         std::string err = ok ? std::string() : out.geterror();
@@ -248,9 +257,11 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
             for (const AovPlane* a : planes)
                 for (int c = 0; c < a->channels; ++c) o[k++] = stored(*a, a->data[i * a->channels + c]);
         }
-        write_atomic(path, as, img.width, img.height, names, OIIO::TypeDesc::FLOAT, buf.data(), true);
+        write_atomic(path, as, img.width, img.height, names, OIIO::TypeDesc::FLOAT, buf.data(), true, img.row0, img.full_height);
         return;
     }
+    if (img.full_height > 0)
+        throw std::runtime_error("cannot write '" + path + "': a band of a picture (render --tiles) is written as exr, for sdfc merge");
 
     // Other formats: AOVs go to side files (written first: the main image appearing last
     // means the whole set is complete).
@@ -297,6 +308,9 @@ Image oiio_read_image(const std::string& path) {
     }
     const OIIO::ImageSpec spec = in->spec();
     const int w = spec.width, h = spec.height, nch = spec.nchannels;
+    const bool band = spec.y != 0 || spec.full_height != spec.height;  // a data window: a band (--tiles)
+    if (band && (spec.x != 0 || spec.full_x != 0 || spec.full_y != 0 || spec.full_width != w || spec.y < 0 || spec.y + h > spec.full_height))
+        throw std::runtime_error("cannot read '" + path + "': its data window is not a band of whole rows of its picture");
     std::vector<float> buf(static_cast<size_t>(w) * h * nch);
     if (!in->read_image(0, 0, 0, nch, OIIO::TypeDesc::FLOAT, buf.data())) {
         std::string e = in->geterror();
@@ -319,6 +333,7 @@ Image oiio_read_image(const std::string& path) {
     }
     const size_t n = static_cast<size_t>(w) * h;
     Image img(w, h, std::max<int>(1, static_cast<int>(colour.size())));
+    if (band) img.row0 = spec.y, img.full_height = spec.full_height;
     for (size_t i = 0; i < n; ++i)
         for (size_t k = 0; k < colour.size(); ++k) {
             float v = buf[i * nch + colour[k]];
