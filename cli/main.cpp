@@ -83,48 +83,62 @@ constexpr const char* kOverrideFlags[] = {"--width",     "--height",  "--samples
                                           "--max-steps", "--max-bounces", "--max-distance", "--epsilon", "--shadows", "--ao", "--aa",
                                           "--exposure",  "--tonemap"};
 
+// The render(...) flags of `sdfc glsl`: the shader's knobs and constants (its size is the viewport's).
+constexpr const char* kGlslFlags[] = {"--samples", "--max-steps", "--max-bounces", "--max-distance", "--epsilon", "--shadows",
+                                      "--ao",      "--aa",        "--exposure",    "--tonemap"};
+
 bool ov_has(const Overrides& ov, const char* flag) {
     for (auto& [k, v] : ov)
         if (k == flag && v) return true;
     return false;
 }
 
-void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
+Args flat_args(const Overrides& ov) {
     std::vector<std::string> flat;
     for (auto& [k, v] : ov)
         if (v) { flat.push_back(k); flat.push_back(*v); }
-    Args a(flat);
-    bool sized = false;  // the size comes from flags, not (only) from the script
+    return Args(flat);
+}
+
+// The flags of render(...)'s settings, with the script's names and ranges; true when the
+// picture's size came from them.
+bool apply_render_flags(RenderSettings& r, Args& a) {
+    bool sized = false;
     // The limits of render(width=, height=) and of slice.
-    if (auto v = a.value("--width")) cs.render.width = Args::to_int("--width", *v, 1, 16384), sized = true;
-    if (auto v = a.value("--height")) cs.render.height = Args::to_int("--height", *v, 1, 16384), sized = true;
-    if (auto v = a.value("--samples")) cs.render.samples = Args::to_int("--samples", *v, 1, 4096), sized = true;
-    // The rest of render(...): the same names and ranges as the script's.
-    if (auto v = a.value("--max-steps")) cs.render.max_steps = Args::to_int("--max-steps", *v, 1, 100000);
-    if (auto v = a.value("--max-bounces")) cs.render.max_bounces = Args::to_int("--max-bounces", *v, 0, 64);
-    for (auto [flag, field] : {std::pair{"--max-distance", &cs.render.max_distance}, std::pair{"--epsilon", &cs.render.epsilon}})
+    if (auto v = a.value("--width")) r.width = Args::to_int("--width", *v, 1, 16384), sized = true;
+    if (auto v = a.value("--height")) r.height = Args::to_int("--height", *v, 1, 16384), sized = true;
+    if (auto v = a.value("--samples")) r.samples = Args::to_int("--samples", *v, 1, 4096), sized = true;
+    if (auto v = a.value("--max-steps")) r.max_steps = Args::to_int("--max-steps", *v, 1, 100000);
+    if (auto v = a.value("--max-bounces")) r.max_bounces = Args::to_int("--max-bounces", *v, 0, 64);
+    for (auto [flag, field] : {std::pair{"--max-distance", &r.max_distance}, std::pair{"--epsilon", &r.epsilon}})
         if (auto v = a.value(flag)) {
             *field = Args::to_float(flag, *v);
             if (!(*field > 0.0f)) throw UsageError(fmt::format("{} must be above 0, not {}", flag, *v));
-            if (field == &cs.render.max_distance) cs.render.max_distance_set = true;
+            if (field == &r.max_distance) r.max_distance_set = true;
         }
-    for (auto [flag, field] : {std::pair{"--shadows", &cs.render.shadows}, std::pair{"--ao", &cs.render.ao}})
+    for (auto [flag, field] : {std::pair{"--shadows", &r.shadows}, std::pair{"--ao", &r.ao}})
         if (auto v = a.value(flag)) {
             if (*v != "on" && *v != "off") throw UsageError(fmt::format("{} takes on or off, not '{}'", flag, *v));
             *field = *v == "on";
         }
     if (auto v = a.value("--exposure")) {
-        cs.render.exposure = Args::to_float("--exposure", *v);
-        if (!(cs.render.exposure > 0.0f)) throw UsageError(fmt::format("--exposure must be above 0, not {}", *v));
+        r.exposure = Args::to_float("--exposure", *v);
+        if (!(r.exposure > 0.0f)) throw UsageError(fmt::format("--exposure must be above 0, not {}", *v));
     }
     if (auto v = a.value("--tonemap")) {
         if (*v != "none" && *v != "reinhard" && *v != "aces") throw UsageError(fmt::format("--tonemap takes none, reinhard or aces, not '{}'", *v));
-        cs.render.tonemap = *v;
+        r.tonemap = *v;
     }
     if (auto v = a.value("--aa")) {
         if (*v != "grid" && *v != "cone") throw UsageError(fmt::format("--aa takes grid or cone, not '{}'", *v));
-        cs.render.aa = *v;
+        r.aa = *v;
     }
+    return sized;
+}
+
+void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
+    Args a = flat_args(ov);
+    const bool sized = apply_render_flags(cs.render, a);  // the size comes from flags, not (only) from the script
     if (auto v = a.value("--camera-position")) {
         auto f = Args::to_floats("--camera-position", *v, 3);
         cs.camera.position = {f[0], f[1], f[2]};
@@ -472,7 +486,18 @@ int cmd_glsl(Args& a) {
     Common c = read_common(a);
     auto target = a.value("--target");
     auto out = a.value("-o", "--output");
+    auto code = a.value("--code");
+    Overrides ov;
+    for (const char* f : kGlslFlags) ov.emplace_back(f, a.value(f));
     std::string path = one_scene(a, "glsl");
+    GlslOptions go;
+    go.sample = sample_batch;
+    if (code) {
+        if (*code == "auto") go.code = GlslCode::Auto;
+        else if (*code == "straight") go.code = GlslCode::Straight;
+        else if (*code == "tape") go.code = GlslCode::Tape;
+        else throw UsageError(fmt::format("--code takes auto, straight or tape, not '{}'", *code));
+    }
     GlslTarget t = GlslTarget::Shadertoy;
     if (target) {
         if (*target == "shadertoy") t = GlslTarget::Shadertoy;
@@ -490,7 +515,9 @@ int cmd_glsl(Args& a) {
     Scene s = load_scene(sm, path, o);
     print_warnings(s);
     if (out) check_not_input(*out, sm);
-    std::string text = emit_glsl(s, t, sample_batch);
+    Args flags = flat_args(ov);
+    apply_render_flags(s.render, flags);
+    std::string text = compile_glsl(s, t, go).text;
     if (!out) {
         write_stdout(text);
         return 0;

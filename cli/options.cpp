@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "compiler/glsl/glsl.hpp"
 #include "compiler/scene/scene.hpp"
 #include "lang/interpreter.hpp"
 #include "runtime/cpu/slice.hpp"
@@ -33,6 +34,15 @@ std::vector<Option> render_settings() {
         {"--exposure", "", "E", "", fmt::format("{}", r.exposure), "the picture's radiance is multiplied by E before tone mapping"},
         {"--tonemap", "", "none|reinhard|aces", "none reinhard aces", r.tonemap, "tone mapping; none clips at 1"},
     };
+}
+
+// The render(...) flags that mean something in a shader (its size is the viewport's, its
+// camera the script's or the user's orbit).
+std::vector<Option> glsl_settings() {
+    std::vector<Option> out;
+    for (const Option& o : render_settings())
+        if (o.name != "--width" && o.name != "--height" && o.name.rfind("--camera", 0) != 0 && o.name != "--fov") out.push_back(o);
+    return out;
 }
 
 std::vector<Option> with(std::vector<Option> a, const std::vector<Option>& b) {
@@ -79,13 +89,19 @@ std::vector<CommandSpec> make_commands() {
                  "frame of every scene compiles before the first picture is written: an error leaves no output.",
                  true});
     c.push_back({"glsl", "SCENE", "the scene as a GLSL shader (Shadertoy, GLSL 3.30, a WebGL2 page)",
-                 {
+                 with({
                      {"--target", "", "shadertoy|glsl330|html", "shadertoy glsl330 html", "shadertoy",
                       "shadertoy: paste into shadertoy.com; glsl330: a desktop fragment shader; html: one self-contained page "
                       "with an orbit camera"},
                      {"--output", "-o", "OUT", "FILE", "standard output", "the file to write"},
-                 },
-                 "", true});
+                     {"--code", "", "auto|straight|tape", "auto straight tape", "auto",
+                      fmt::format("straight: a GLSL statement per instruction; tape: the programs as data for a small interpreter "
+                                  "(the shader's code does not grow with the scene); auto: tape from {} instructions",
+                                  kTapeThreshold)},
+                 }, glsl_settings()),
+                 "The settings flags override the script's render(...); --samples, --max-steps and --max-bounces set the "
+                 "#defines at the top of a pasted shader (the html page's controls start from them).",
+                 true});
     c.push_back({"compile", "SCENE --emit ast|ir|bytecode", "print a stage of the compiler",
                  {{"--emit", "", "ast|ir|bytecode", "ast ir bytecode", "", "the syntax tree, the IR or the VM's bytecode listing"}}, "",
                  true});

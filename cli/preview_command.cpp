@@ -21,6 +21,7 @@
 #include "cli/file_watch.hpp"
 #include "cli/preview/server_api.hpp"
 #include "compiler/glsl/glsl.hpp"
+#include "compiler/glsl/glsl_tape.hpp"
 #include "lang/load.hpp"
 #include "runtime/eval/vm.hpp"
 #include "runtime/io/module.hpp"
@@ -32,7 +33,8 @@ namespace {
 struct Build {
     bool ok = false;
     std::string shader, message;
-    bool uses_time = false;
+    std::string tape;  // base64 words of the shader's tape texture ("" for straight-line code)
+    std::string scene;  // the page's facts of the scene (JSON: time, knobs, parameters)
 };
 
 Build build_shader(const std::string& path, const Common& c) {
@@ -43,7 +45,12 @@ Build build_shader(const std::string& path, const Common& c) {
         o.time = std::nullopt;  // `time` becomes iTime
         Scene s = load_scene(sm, path, o);
         print_warnings(s);
-        b.shader = emit_glsl(s, GlslTarget::HtmlShader, sample_batch, &b.uses_time);
+        GlslOptions go;
+        go.sample = sample_batch;
+        GlslOutput out = compile_glsl(s, GlslTarget::HtmlShader, go);
+        b.shader = std::move(out.text);
+        b.scene = std::move(out.scene_json);
+        if (!out.tape_words.empty()) b.tape = glsl::tape_base64(out.tape_words);
         b.ok = true;
     } catch (const CompileError& e) {
         b.message = e.formatted();
@@ -57,8 +64,8 @@ Build build_shader(const std::string& path, const Common& c) {
 std::string event_of(const Build& b, const std::string& token, long version, const std::string& title) {
     const std::string head = fmt::format("{{\"server\":{},\"version\":{}", json_string(token), version);
     if (b.ok)
-        return fmt::format("retry: 1000\nevent: scene\ndata: {},\"title\":{},\"uses_time\":{},\"shader\":{}}}\n\n", head,
-                           json_string(title), b.uses_time ? "true" : "false", json_string(b.shader));
+        return fmt::format("retry: 1000\nevent: scene\ndata: {},\"title\":{},\"scene\":{},\"shader\":{},\"tape\":{}}}\n\n", head,
+                           json_string(title), b.scene, json_string(b.shader), json_string(b.tape));
     return fmt::format("retry: 1000\nevent: failed\ndata: {},\"message\":{}}}\n\n", head, json_string(b.message));
 }
 

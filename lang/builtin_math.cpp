@@ -185,6 +185,7 @@ Value Interp::call_math(const BuiltinInfo& info, std::vector<Value>& args, const
         }
         case B::Radians: arity(1, 1); return componentwise(args[0], loc, [&](NodeId x) { return gr.mulc(x, 3.14159265358979f / 180.0f); });
         case B::Degrees: arity(1, 1); return componentwise(args[0], loc, [&](NodeId x) { return gr.mulc(x, 180.0f / 3.14159265358979f); });
+        case B::Param: return make_param(args, locs, loc);
         case B::Noise: {
             arity(1, 1);
             Vec3N p = vec3(args[0], locs[0], "the argument of noise", false);
@@ -193,6 +194,35 @@ Value Interp::call_math(const BuiltinInfo& info, std::vector<Value>& args, const
         default: break;
     }
     fail(loc, fmt::format("internal: {} is not a math function", info.name));
+}
+
+// let name = param(value, min = value - max(|value|, 1), max = value + max(|value|, 1), step):
+// the value, or in GLSL a uniform the html page turns with a slider over [min, max].
+constexpr size_t kMaxParams = 64;
+
+Value Interp::make_param(std::vector<Value>& args, const std::vector<Loc>& locs, Loc loc) {
+    if (param_let.empty())
+        fail(loc, "param(...) gives a top-level let its value, which the html page's slider turns: let size = param(1, 0.1, 3);");
+    if (args.empty() || args.size() > 4) fail(loc, fmt::format("param takes 1 to 4 arguments (value, min, max, step), not {}", args.size()));
+    static const char* const kWhat[] = {"the param's value", "the param's min", "the param's max", "the param's step"};
+    float v[4] = {0, 0, 0, 0};
+    for (size_t i = 0; i < args.size(); ++i) {
+        if (args[i].t != VT::Number) fail(locs[i], fmt::format("{} must be a number, not {}", kWhat[i], describe(args[i])));
+        v[i] = const_num(args[i], locs[i], kWhat[i]);
+        if (!std::isfinite(v[i])) fail(locs[i], fmt::format("{} is not a finite number", kWhat[i]));
+    }
+    const float value = v[0], span = std::max(std::fabs(value), 1.0f);
+    const float lo = args.size() > 1 ? v[1] : value - span, hi = args.size() > 2 ? v[2] : value + span;
+    if (!(lo < hi)) fail(args.size() > 2 ? locs[2] : loc, fmt::format("the param's max ({}) must be above its min ({})", hi, lo));
+    if (value < lo || value > hi) fail(locs[0], fmt::format("the param's value {} is outside [{}, {}]", value, lo, hi));
+    const float step = args.size() > 3 ? v[3] : (hi - lo) / 1000.0f;
+    if (!(step > 0.0f)) fail(locs[3], "the param's step must be above 0");
+    if (opts.time || param_fixed) return Value::number(g->constant(value));  // the CPU (or -D's): a constant
+    // Each is a uniform; WebGL2 promises 224 vectors for a fragment shader, the renderer's own included.
+    if (scene.params.size() >= kMaxParams) fail(loc, fmt::format("a script has at most {} params", kMaxParams));
+    const int index = static_cast<int>(scene.params.size());
+    scene.params.push_back(SceneParam{param_let, value, lo, hi, step, loc});
+    return Value::number(g->with_imm(Op::Param, kNoNode, kNoNode, static_cast<float>(index)));
 }
 
 }  // namespace sdfc

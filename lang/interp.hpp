@@ -134,6 +134,10 @@ public:
     std::vector<bool> define_used;
     Value defined_value(size_t k, const ast::Stmt& let, Env* env);
     void check_defines_used(Env* top);
+    // param(...): the top-level let whose value is being computed ("" elsewhere).
+    std::string param_let;
+    bool param_fixed = false;  // -D gave the let its value: param(...) is a number
+    Value make_param(std::vector<Value>& args, const std::vector<Loc>& locs, Loc loc);
 
     SourceManager& sm;
     InterpretOptions opts;

@@ -66,7 +66,7 @@ NodeId Interp::num(const Value& v, Loc loc, const char* what) {
 
 float Interp::const_num(const Value& v, Loc loc, const char* what) {
     NodeId n = num(v, loc, what);
-    if (!g->is_const(n)) fail(loc, fmt::format("{} must be known when the script runs (it depends on the point or on time)", what));
+    if (!g->is_const(n)) fail(loc, fmt::format("{} must be known when the script runs (it depends on the point, on time or on a param)", what));
     return g->const_value(n);
 }
 
@@ -197,7 +197,20 @@ Value Interp::defined_value(size_t k, const ast::Stmt& let, Env* env) {
         if (m.stmts.size() != 1 || m.stmts[0]->kind != ast::StmtKind::Expr || !m.stmts[0]->value)
             throw DefineError(fmt::format("{}: the value must be one expression", what));
         Value v = eval(*m.stmts[0]->value, env);
-        Value own = eval(*let.value, env);
+        // The script's own value, for its kind: a param(...) in it is checked, not made.
+        const std::string outer = param_let;
+        param_let = let.name;
+        param_fixed = true;
+        Value own;
+        try {
+            own = eval(*let.value, env);
+        } catch (...) {
+            param_let = outer;
+            param_fixed = false;
+            throw;
+        }
+        param_let = outer;
+        param_fixed = false;
         if (v.t != own.t || v.n != own.n)
             throw DefineError(fmt::format("{}: the script's '{}' (line {}) is {}, not {}", what, d.name, let.name_loc.line, describe(own),
                                           describe(v)));
@@ -276,7 +289,18 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             if (env == main_env && s.kind == ast::StmtKind::Let)
                 for (size_t k = 0; k < opts.defines.size() && !defined; ++k)
                     if (opts.defines[k].name == s.name) v = defined_value(k, s, env), defined = true;
-            if (!defined) v = eval(*s.value, env);
+            if (!defined) {
+                // A param(...) here is named after the let (a -D value above replaces it).
+                const std::string outer = param_let;
+                param_let = env == main_env && s.kind == ast::StmtKind::Let ? s.name : "";
+                try {
+                    v = eval(*s.value, env);
+                } catch (...) {
+                    param_let = outer;
+                    throw;
+                }
+                param_let = outer;
+            }
             env->vars[s.name] = Binding{std::move(v), s.kind == ast::StmtKind::Var, s.name_loc};
             return;
         }

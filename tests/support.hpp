@@ -40,6 +40,15 @@ inline Program single_op_program(Op op, float k) {
     p.code.push_back(Instr{Op::VarZ, 0, 2});
     Instr in{op};
     in.out = 3, in.a = 0, in.b = 1, in.c = 2, in.k = k;
+    if (op == Op::Guard) {  // a guard whose region is empty: +inf whether it skips or not
+        in.k = 0.0f;
+        Guard g;
+        g.px = 0, g.py = 1, g.pz = 2;
+        g.lo[0] = g.lo[1] = g.lo[2] = -1.0f;
+        g.hi[0] = g.hi[1] = g.hi[2] = 1.0f;
+        g.end = 4;
+        p.guards.push_back(g);
+    }
     p.code.push_back(in);
     p.locs.resize(p.code.size());
     p.num_regs = 4;

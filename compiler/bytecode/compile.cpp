@@ -10,6 +10,7 @@
 namespace sdfc {
 
 LoweredScene lower_scene(Graph& g, const Scene& scene) {
+    g.clear_guards();  // codegen takes the regions of this lowering
     Vec3N p{g.input(Op::VarX), g.input(Op::VarY), g.input(Op::VarZ)};
     LoweredScene out;
     // One pass gives both: the distance nodes are the same with or without materials.

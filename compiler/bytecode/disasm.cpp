@@ -15,6 +15,11 @@ std::string disassemble(const Program& p) {
         const uint16_t ops[3] = {in.a, in.b, in.c};
         for (int j = 0; j < info.arity; ++j) line += fmt::format(", r{}", ops[j]);
         if (info.has_imm) line += fmt::format(", {}", in.k);
+        if (in.op == Op::Guard && guard_index(in) < p.guards.size()) {
+            const Guard& gd = p.guards[guard_index(in)];
+            line += fmt::format(" at r{} r{} r{} in [{}, {}, {}]..[{}, {}, {}] to {:04}", gd.px, gd.py, gd.pz, gd.lo[0], gd.lo[1], gd.lo[2],
+                                gd.hi[0], gd.hi[1], gd.hi[2], gd.end);
+        }
         if (i < p.locs.size() && p.locs[i].known()) line = fmt::format("{:<44}; line {}", line, p.locs[i].line);
         out += line;
         out += '\n';

@@ -35,8 +35,26 @@ struct TapeView {
     uint16_t output(uint32_t i = 0) const { return outputs[i]; }
 };
 
+// What a `guard` instruction (Op::Guard, its k the index here) knows of its region:
+// instructions (guard, end) compute a union's child (compiler/scene/shapes_csg.cpp), whose
+// surface lies in the box [lo, hi] around the point in registers (px, py, pz). Where the
+// point is outside the box by at least the guard's threshold register (the union's distance
+// so far), the child cannot be nearer: an evaluator may jump to `end`, leaving +inf in the
+// guard's out, which the region's last instruction would have written. The child's other
+// results (its material channels) then keep stale values that the union's choices never
+// pick. Evaluators that do not skip run through: the result is the same.
+struct Guard {
+    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    uint16_t px = 0, py = 0, pz = 0;
+    uint32_t end = 0;
+};
+
+// A guard instruction's entry in Program::guards: its k (operand fields hold registers only).
+inline size_t guard_index(const Instr& in) { return static_cast<size_t>(in.k); }
+
 struct Program {
     std::vector<Instr> code;
+    std::vector<Guard> guards;      // of the guard instructions (k: the index), in order
     std::vector<Loc> locs;          // per instruction: the script location that made it
     uint32_t num_regs = 0;
     std::vector<uint16_t> outputs;  // register of each output
@@ -50,14 +68,20 @@ struct Program {
 
 // Linear-scan register allocation over the live nodes reachable from `roots`; constant
 // operands become immediates where an *_I form exists; Add(MulI(x), y) fuses to MulAddI.
+// The graph's guarded regions (Graph::guards) become guard instructions, each region's
+// instructions scheduled together after its guard.
 Program codegen(const Graph& g, const std::vector<NodeId>& roots, const std::vector<std::string>& names);
 
 // One line per instruction (`sdfc compile --emit bytecode`): index, mnemonic, registers,
 // immediate, and the script line.
 std::string disassemble(const Program& p);
 
-// Reference evaluation of one point, one instruction at a time (tests, the constant folder's twin).
-std::vector<float> eval_scalar(const Program& p, float x, float y, float z, float time = 0.0f);
+// Reference evaluation of one point, one instruction at a time (tests, the constant folder's
+// twin). `skip`: jump over guarded regions whose guard allows it (guard_skips), as the GLSL
+// tape interpreter does; the outputs are the same but where a shape's distance is a loose bound.
+std::vector<float> eval_scalar(const Program& p, float x, float y, float z, float time = 0.0f, bool skip = false);
+// Whether the guard `in` (Op::Guard) lets an evaluator skip its region, given the registers.
+bool guard_skips(const Program& p, const Instr& in, const float* regs);
 
 // The first output of `p` at n points, into out: how a stage below the runtime samples a
 // field (the raw-field Lipschitz estimate). sample_scalar is the reference; the runtime's

@@ -3,12 +3,33 @@
 // and what the GLSL backend samples a raw field with.
 #include "compiler/bytecode/program.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace sdfc {
 
-std::vector<float> eval_scalar(const Program& p, float x, float y, float z, float time) {
+bool guard_skips(const Program& p, const Instr& in, const float* r) {
+    const Guard& gd = p.guards.at(guard_index(in));
+    const float q[3] = {r[gd.px], r[gd.py], r[gd.pz]};
+    float e2 = 0.0f;
+    for (int i = 0; i < 3; ++i) {
+        const float e = std::max(std::max(gd.lo[i] - q[i], q[i] - gd.hi[i]), 0.0f);
+        e2 += e * e;
+    }
+    const float e = std::sqrt(e2);
+    return e > 0.0f && e >= r[in.a];
+}
+
+std::vector<float> eval_scalar(const Program& p, float x, float y, float z, float time, bool skip) {
     std::vector<float> r(p.num_regs, 0.0f);
-    for (const Instr& in : p.code) {
+    for (size_t i = 0; i < p.code.size(); ++i) {
+        const Instr& in = p.code[i];
         float v;
+        if (in.op == Op::Guard && skip && guard_skips(p, in, r.data())) {
+            r[in.out] = om::kSkipped;
+            i = p.guards[guard_index(in)].end - 1;
+            continue;
+        }
         switch (in.op) {
             case Op::VarX: v = x; break;
             case Op::VarY: v = y; break;
@@ -25,7 +46,7 @@ std::vector<float> eval_scalar(const Program& p, float x, float y, float z, floa
 
 void sample_scalar(const Program& p, const float* x, const float* y, const float* z, size_t n, float time, float* out) {
     if (p.outputs.empty()) return;
-    for (size_t i = 0; i < n; ++i) out[i] = eval_scalar(p, x[i], y[i], z[i], time)[0];
+    for (size_t i = 0; i < n; ++i) out[i] = eval_scalar(p, x[i], y[i], z[i], time, false)[0];
 }
 
 }  // namespace sdfc

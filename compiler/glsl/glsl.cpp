@@ -29,6 +29,7 @@
 #include "compiler/glsl/glsl_emit.hpp"
 #include "compiler/glsl/glsl_html.hpp"
 #include "compiler/glsl/glsl_renderer.hpp"
+#include "compiler/glsl/glsl_tape.hpp"
 #include "compiler/scene/lower.hpp"
 
 namespace sdfc {
@@ -60,9 +61,15 @@ struct Parts {
     std::string name;       // script file name
     std::string code;       // everything but the entry point (no #version, no uniforms)
     bool uses_time = false;
+    bool tape = false;
+    std::vector<uint32_t> tape_words;
+    size_t instructions = 0;
+    int samples = 1, max_steps = 256, max_bounces = 3;  // the knobs (knob_block)
+    std::vector<SceneParam> params;                    // the script's params (sdf_param[i])
 };
 
-Parts generate(const Scene& scene, FieldSampler sample) {
+Parts generate(const Scene& scene, const GlslOptions& options, glsl::TapeStorage storage) {
+    const FieldSampler sample = options.sample;
     Graph& g = *scene.graph;
     const Loc saved = g.loc();
     g.set_loc(Loc{});  // nodes made outside any shape (the scene's final scaling) name no line
@@ -124,26 +131,24 @@ Parts generate(const Scene& scene, FieldSampler sample) {
     std::string& c = out.code;
     c += fmt::format(
         "// ---- render settings (the script's render(...)) ----\n"
-        "const int SDF_MAX_STEPS = {};\n"
         "const float SDF_MAX_DIST = {};\n"
         "const float SDF_EPSILON = {};\n"
         "const bool SDF_SHADOWS = {};\n"
         "const bool SDF_AO = {};  // ambient occlusion\n"
-        "const int SDF_MAX_BOUNCES = {};\n"
         "const bool SDF_CONE = {};  // cone-traced anti-aliasing (render(aa = \"cone\"))\n"
         "const bool SDF_2D = {};  // a 2D model: the Prospero image\n"
         "const bool SDF_ORTHO = {};  // orthographic camera\n"
         "const float SDF_EXPOSURE = {};\n"
         "const int SDF_TONEMAP = {};  // 0 none, 1 Reinhard, 2 ACES\n",
-        plan.max_steps, literal(plan.max_dist), literal(plan.eps), plan.shadows ? "true" : "false", plan.ao ? "true" : "false",
-        plan.max_bounces, plan.cone ? "true" : "false", plan.is_2d ? "true" : "false", cam.orthographic ? "true" : "false",
+        literal(plan.max_dist), literal(plan.eps), plan.shadows ? "true" : "false", plan.ao ? "true" : "false",
+        plan.cone ? "true" : "false", plan.is_2d ? "true" : "false", cam.orthographic ? "true" : "false",
         literal(plan.exposure), plan.tonemap);
-    c += fmt::format("const int SDF_SAMPLES = {};  // samples per pixel\nconst vec2 SDF_OFFSETS[SDF_SAMPLES] = vec2[SDF_SAMPLES](", plan.samples);
-    for (int i = 0; i < plan.samples; ++i)
-        c += fmt::format("{}vec2({}, {})", i ? (i % 4 == 0 ? ",\n    " : ", ") : "", literal(plan.offsets[i].x), literal(plan.offsets[i].y));
-    c += ");\n";
-    c += fmt::format("const float SDF_SAMPLE_WEIGHT = {};\nconst float SDF_MIN_WEIGHT = {};\n",
-                     literal(1.0f / static_cast<float>(plan.samples)), literal(plan.min_weight));
+    // A sample's weight, and the least a secondary ray may carry (compiler/render/plan.cpp).
+    c += "#define SDF_SAMPLE_WEIGHT (1.0 / float(SDF_SAMPLES))\n#define SDF_MIN_WEIGHT (1e-3 / float(SDF_SAMPLES))\n";
+    out.samples = plan.samples;
+    out.max_steps = plan.max_steps;
+    out.max_bounces = plan.max_bounces;
+    out.params = scene.params;
     c += fmt::format("const bool SDF_CLIP = {};  // rays are clipped to the scene's bounding box\n", plan.clip ? "true" : "false");
     c += fmt::format("const vec3 SDF_LO = {};\nconst vec3 SDF_HI = {};\n", vec3_lit(plan.lo.x, plan.lo.y, plan.lo.z),
                      vec3_lit(plan.hi.x, plan.hi.y, plan.hi.z));
@@ -174,16 +179,11 @@ Parts generate(const Scene& scene, FieldSampler sample) {
     c += glsl::kRendererHead;
     c += glsl::op_helpers({&dist, &mat, &set});
 
+    out.instructions = dist.code.size() + mat.code.size();
+    out.tape = options.code == GlslCode::Tape || (options.code == GlslCode::Auto && out.instructions >= kTapeThreshold);
     glsl::FunctionSpec fs;
     if (scene.root->kind == ShapeKind::Union) fs.quiet = scene.root->loc;
-    fs.signature = "float map(vec3 p)";
-    fs.var_prefix = "d";
-    c += "\n// ---- the scene's distance (a safe bound: 1-Lipschitz) ----\n";
-    c += glsl::function(dist, fs);
-
-    fs.signature = "Material sdf_material(vec3 p)";
-    fs.var_prefix = "m";
-    fs.finish = [](const std::vector<std::string>& o) {
+    auto material_return = [](const std::vector<std::string>& o) {
         // Channels that are not a plain name or number get a named local, for readability.
         std::vector<std::string> lines, v(o.begin(), o.end());
         for (int i = 0; i < kMatChannels; ++i)
@@ -195,8 +195,38 @@ Parts generate(const Scene& scene, FieldSampler sample) {
                                     v[5], v[6], v[7], v[8], v[9], v[10]));
         return lines;
     };
-    c += "\n// ---- materials: colour, specular, shininess, reflectance, transparency, ior, emission ----\n";
-    c += glsl::function(mat, fs);
+    if (out.tape) {
+        // The programs as data (compiler/glsl/glsl_tape.hpp): the shader's code does not grow
+        // with the scene.
+        const glsl::PackedTapes t = glsl::pack_tapes({&dist, &mat});
+        c += "\n";
+        c += glsl::tape_interpreter(t, storage);
+        const glsl::TapeSegment &sd = t.segments[0], &sm = t.segments[1];
+        auto reg = [](uint16_t r) { return fmt::format("sdf_reg[{}]", r); };
+        c += fmt::format(
+            "\n// ---- the scene's distance (a safe bound: 1-Lipschitz): {} instructions of the tape ----\n"
+            "float map(vec3 p) {{\n    sdf_run({}, {}, p);\n    return {};\n}}\n",
+            dist.code.size(), sd.begin, sd.end, reg(sd.outputs[0]));
+        std::vector<std::string> o;
+        for (uint16_t r : sm.outputs) o.push_back(reg(r));
+        c += fmt::format(
+            "\n// ---- materials: colour, specular, shininess, reflectance, transparency, ior, emission: {} instructions of the tape ----\n"
+            "Material sdf_material(vec3 p) {{\n    sdf_run({}, {}, p);\n",
+            mat.code.size(), sm.begin, sm.end);
+        for (const std::string& line : material_return(o)) c += "    " + line + "\n";
+        c += "}\n";
+        if (storage == glsl::TapeStorage::Texture) out.tape_words = t.words;
+    } else {
+        fs.signature = "float map(vec3 p)";
+        fs.var_prefix = "d";
+        c += "\n// ---- the scene's distance (a safe bound: 1-Lipschitz) ----\n";
+        c += glsl::function(dist, fs);
+        fs.signature = "Material sdf_material(vec3 p)";
+        fs.var_prefix = "m";
+        fs.finish = material_return;
+        c += "\n// ---- materials: colour, specular, shininess, reflectance, transparency, ior, emission ----\n";
+        c += glsl::function(mat, fs);
+    }
 
     fs.signature = "void sdf_settings()";
     fs.var_prefix = "s";
@@ -240,18 +270,72 @@ std::string header(const Parts& p, const char* target_line) {
     return fmt::format("// Generated by sdfc from {}.\n{}", p.name, target_line);
 }
 
+// What the html page needs to know of the scene besides its shader: whether time matters,
+// the knobs' values for the script.
+std::string scene_json(const Parts& p) {
+    std::string params;
+    for (size_t i = 0; i < p.params.size(); ++i) {
+        const SceneParam& q = p.params[i];
+        params += fmt::format("{}{{\"name\":\"{}\",\"value\":{},\"min\":{},\"max\":{},\"step\":{},\"uniform\":\"sdf_param[{}]\"}}", i ? "," : "",
+                              q.name, q.value, q.min, q.max, q.step, i);
+    }
+    return fmt::format("{{\"uses_time\":{},\"samples\":{},\"max_steps\":{},\"max_bounces\":{},\"params\":[{}]}}",
+                       p.uses_time ? "true" : "false", p.samples, p.max_steps, p.max_bounces, params);
+}
+
+// The script's params: uniforms the page's sliders set, or #defines at the top of a pasted
+// shader (a param's line names it in the script).
+std::string param_block(const Parts& p, bool uniforms) {
+    const size_t n = p.params.size();
+    if (n == 0) return "";
+    if (uniforms) return fmt::format("uniform float sdf_param[{}];  // the script's params (the page's sliders)\n", n);
+    std::string s = "// ---- the script's params (let NAME = param(...)): edit these ----\n";
+    std::string list;
+    for (size_t i = 0; i < n; ++i) {
+        const SceneParam& q = p.params[i];
+        s += fmt::format("#define SDF_PARAM_{} {}  // in [{}, {}]; line {}\n", q.name, literal(q.value), literal(q.min), literal(q.max),
+                         q.loc.line);
+        list += fmt::format("{}SDF_PARAM_{}", i ? ", " : "", q.name);
+    }
+    s += fmt::format("const float sdf_param[{}] = float[{}]({});\n\n", n, n, list);
+    return s;
+}
+
+// The settings a user turns while looking: #defines at the top of a pasted shader, uniforms
+// the html page sets (its controls; the stack of rays is sized for kPageBounceCap bounces).
+constexpr int kPageBounceCap = 8;
+std::string knob_block(const Parts& p, GlslTarget target) {
+    if (target == GlslTarget::Html || target == GlslTarget::HtmlShader)
+        return fmt::format(
+            "uniform int uSamples;     // samples per pixel (the page's control; script: {})\n"
+            "uniform int uMaxSteps;    // sphere-tracing steps a ray (script: {})\n"
+            "uniform int uMaxBounces;  // mirror and glass bounces (script: {})\n"
+            "const int SDF_BOUNCE_CAP = {};\n"
+            "#define SDF_SAMPLES (SDF_CONE ? 1 : max(uSamples, 1))\n"
+            "#define SDF_MAX_STEPS uMaxSteps\n"
+            "#define SDF_MAX_BOUNCES min(uMaxBounces, SDF_BOUNCE_CAP)\n{}",
+            p.samples, p.max_steps, p.max_bounces, std::max(kPageBounceCap, p.max_bounces), param_block(p, true));
+    return fmt::format(
+        "// ---- knobs: edit these (sdfc glsl --samples N --max-steps N --max-bounces N sets them) ----\n"
+        "#define SDF_SAMPLES {:<8}// samples per pixel (anti-aliasing; 1 with render(aa = \"cone\"))\n"
+        "#define SDF_MAX_STEPS {:<6}// sphere-tracing steps a ray\n"
+        "#define SDF_MAX_BOUNCES {:<4}// mirror and glass bounces\n"
+        "#define SDF_BOUNCE_CAP SDF_MAX_BOUNCES\n\n{}",
+        p.samples, p.max_steps, p.max_bounces, param_block(p, false));
+}
+
 }  // namespace
 
-std::string emit_glsl(const Scene& scene, GlslTarget target, FieldSampler sample, bool* uses_time) {
-    if (!scene.graph || !scene.root) throw CompileError(Loc{}, "internal: the scene has no graph");
-    Parts p = generate(scene, sample);
-    if (uses_time) *uses_time = p.uses_time;
+namespace {
+
+std::string target_text(const Parts& p, GlslTarget target) {
     switch (target) {
         case GlslTarget::Shadertoy: {
             std::string s = header(p,
                                    "// Shadertoy: paste into a new shader's Image tab on shadertoy.com. The script's `time` is\n"
                                    "// iTime; drag with the mouse to orbit the camera around its target (release: the\n"
                                    "// script's camera). The picture matches `sdfc render` (same camera, tracing and shading).\n\n");
+            s += knob_block(p, target);
             s += p.code;
             s += "\nvoid mainImage(out vec4 fragColor, in vec2 fragCoord) {\n"
                  "    fragColor = sdf_render(fragCoord, iResolution.xy, iTime, sdf_mouse_orbit(iMouse, iResolution.xy), vec2(0.0));\n"
@@ -272,6 +356,7 @@ std::string emit_glsl(const Scene& scene, GlslTarget target, FieldSampler sample
                         "// without GL_FRAMEBUFFER_SRGB.\n\n");
             // Shadertoy's names (LANGUAGE.md: `time` becomes iTime in GLSL).
             s += "uniform vec2 iResolution;\nuniform float iTime;\nuniform vec4 iMouse;\nout vec4 fragColor;\n\n";
+            s += knob_block(p, target);
             s += p.code;
             s += "\nvoid main() {\n"
                  "    fragColor = sdf_render(gl_FragCoord.xy, iResolution, iTime, sdf_mouse_orbit(iMouse, iResolution), vec2(0.0));\n"
@@ -281,26 +366,51 @@ std::string emit_glsl(const Scene& scene, GlslTarget target, FieldSampler sample
         case GlslTarget::Html:
         case GlslTarget::HtmlShader: {
             std::string s = "#version 300 es\n";
-            s += header(p, "// WebGL2 preview shader (GLSL ES 3.00): the Shadertoy code plus uniforms for the page's camera.\n\n");
-            s += "precision highp float;\nprecision highp int;\n"
+            s += header(p, "// WebGL2 preview shader (GLSL ES 3.00): the Shadertoy code with its knobs and the page's camera as uniforms.\n\n");
+            s += "precision highp float;\nprecision highp int;\nprecision highp sampler2D;\n"
                  "uniform vec3 iResolution;\nuniform float iTime;\nuniform vec4 iMouse;\n"
                  "uniform vec4 uOrbit;  // yaw, pitch (radians), zoom, on\n"
                  "uniform vec2 uPan;    // target offset in the view plane, in units of the orbit radius\n"
-                 "out vec4 sdf_frag_color;\n\n";
+                 "out vec4 sdf_frag_color;\n";
+            s += knob_block(p, target);
+            s += "\n";
             s += p.code;
-            s += "\nvoid mainImage(out vec4 fragColor, in vec2 fragCoord) {\n"
-                 "    fragColor = sdf_render(fragCoord, iResolution.xy, iTime, sdf_mouse_orbit(iMouse, iResolution.xy), vec2(0.0));\n"
-                 "}\n\n"
-                 "void main() {\n"
-                 "    sdf_frag_color = sdf_render(gl_FragCoord.xy, iResolution.xy, iTime, uOrbit, uPan);\n"
-                 "}\n";
+            s += "\n";
+            s += glsl::kPageMain;
             if (target == GlslTarget::HtmlShader) return s;
-            return glsl::html_page(p.name, s, p.uses_time);
+            return glsl::html_page(p.name, s, scene_json(p), false, p.tape_words);
         }
     }
     return {};
 }
 
-std::string html_live_page(const std::string& title) { return glsl::html_page(title, "", false, true); }
+}  // namespace
+
+GlslOutput compile_glsl(const Scene& scene, GlslTarget target, const GlslOptions& options) {
+    if (!scene.graph || !scene.root) throw CompileError(Loc{}, "internal: the scene has no graph");
+    const bool page = target == GlslTarget::Html || target == GlslTarget::HtmlShader;
+    Parts p = generate(scene, options, page ? glsl::TapeStorage::Texture : glsl::TapeStorage::ConstArray);
+    GlslOutput out;
+    out.text = target_text(p, target);
+    out.uses_time = p.uses_time;
+    out.tape = p.tape;
+    out.instructions = p.instructions;
+    out.samples = p.samples;
+    out.max_steps = p.max_steps;
+    out.max_bounces = p.max_bounces;
+    out.scene_json = scene_json(p);
+    if (target == GlslTarget::HtmlShader) out.tape_words = std::move(p.tape_words);
+    return out;
+}
+
+std::string emit_glsl(const Scene& scene, GlslTarget target, FieldSampler sample, bool* uses_time) {
+    GlslOptions o;
+    o.sample = sample;
+    GlslOutput out = compile_glsl(scene, target, o);
+    if (uses_time) *uses_time = out.uses_time;
+    return std::move(out.text);
+}
+
+std::string html_live_page(const std::string& title) { return glsl::html_page(title, "", "", true); }
 
 }  // namespace sdfc

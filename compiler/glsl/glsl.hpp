@@ -1,7 +1,9 @@
 // The GLSL backend: the scene's programs as GLSL, generated from the same IR and opcode
 // table as the VM, with the CPU renderer's camera, tracing and shading.
 #pragma once
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "compiler/bytecode/program.hpp"
 #include "compiler/scene/scene.hpp"
@@ -15,11 +17,34 @@ enum class GlslTarget {
     HtmlShader, // the Html page's WebGL2 fragment shader alone (sdfc preview sends it to its page)
 };
 
+// How the scene's programs become shader code: straight-line GLSL (a statement per
+// instruction), or data for the tape interpreter (compiler/glsl/glsl_tape.hpp); Auto picks
+// the tape for programs of kTapeThreshold instructions or more.
+enum class GlslCode { Auto, Straight, Tape };
+inline constexpr size_t kTapeThreshold = 10000;  // distance + shading instructions (docs/glsl.md: the measurements)
+
+struct GlslOptions {
+    GlslCode code = GlslCode::Auto;
+    // Evaluates the distance program for the raw-field Lipschitz estimate (the runtime's
+    // sample_batch is the fast one; the result is the same).
+    FieldSampler sample = sample_scalar;
+};
+
+struct GlslOutput {
+    std::string text;                  // the shader, or the page for Html
+    bool uses_time = false;            // the shader depends on iTime
+    bool tape = false;                 // the programs are a tape
+    std::vector<uint32_t> tape_words;  // HtmlShader with a tape: the words of its sdf_tape texture
+    size_t instructions = 0;           // of the distance and shading programs
+    int samples = 1, max_steps = 256, max_bounces = 3;  // the knobs' values for the script (Html: their uniforms)
+    std::string scene_json;            // what the html page reads besides the shader (time, knobs, parameters)
+};
+
 // `scene` must be built with a symbolic time (InterpretOptions::time = nullopt) so `time`
 // becomes iTime. Throws CompileError for settings GLSL cannot express.
-// `sample` evaluates the distance program for the raw-field Lipschitz estimate (the
-// runtime's sample_batch is the fast one; the result is the same). `uses_time`, if given, is
-// set to whether the shader depends on iTime.
+GlslOutput compile_glsl(const Scene& scene, GlslTarget target, const GlslOptions& options = {});
+
+// The text of compile_glsl; `uses_time`, if given, is set to whether the shader depends on iTime.
 std::string emit_glsl(const Scene& scene, GlslTarget target, FieldSampler sample = sample_scalar, bool* uses_time = nullptr);
 
 // The page of `sdfc preview`: the Html page with no shader of its own; it takes each new

@@ -35,7 +35,7 @@ struct SdfRay {
     bool inside, known;
     int gen;
 };
-const int SDF_STACK = SDF_MAX_BOUNCES + 6;
+const int SDF_STACK = SDF_BOUNCE_CAP + 6;
 
 // What sdf_trace is doing: the states that evaluate the distance once per loop turn...
 const int SDF_ST_MARCH = 0;   // a camera / bounce ray
@@ -345,30 +345,54 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
     return acc;
 }
 
-// The picture at fragCoord (GL convention: origin at the bottom left) for a res-sized
-// viewport at `time`, with an optional interactive orbit (see sdf_orbit).
-vec4 sdf_render(vec2 frag_coord, vec2 res, float time, vec4 orbit, vec2 pan) {
+// The frame's settings and camera for a res-sized viewport at `time`, with an optional
+// interactive orbit (see sdf_orbit); then the pixel's tile pre-march is due. Returns the
+// pixel (column, row from the top).
+vec2 sdf_setup(vec2 frag_coord, vec2 res, float time, vec4 orbit, vec2 pan) {
     sdf_time = time;
     sdf_zero = int(min(res.x, 0.0));
     sdf_settings();
     sdf_init_scene();
     float x = floor(frag_coord.x), row = floor(res.y) - 1.0 - floor(frag_coord.y);
-    if (SDF_2D) {
-        // A 2D model: W x H samples over [-1, 1]^2 including both ends, white inside.
-        float v = map(vec3(sdf_grid_x(int(x), int(res.x)), sdf_grid_y(int(row), int(res.y)), 0.0)) < 0.0 ? 1.0 : 0.0;
-        return vec4(vec3(v), 1.0);
-    }
     vec3 pos = sdf_cam_position, target = sdf_cam_target;
     if (orbit.w > 0.0) sdf_orbit(pos, target, sdf_cam_up, orbit, pan);
     sdf_cam = sdf_make_camera(pos, target, sdf_cam_up, sdf_cam_fov, SDF_ORTHO, sdf_cam_ortho_height, floor(res.x), floor(res.y));
     if (SDF_PREMARCH) sdf_setup_premarch(x, row, floor(res));
-    vec3 acc = vec3(0.0);
-    for (int s = sdf_zero; s < SDF_SAMPLES; ++s) {
-        vec3 o, d;
-        sdf_camera_ray(sdf_cam, x + SDF_OFFSETS[s].x, row + SDF_OFFSETS[s].y, o, d);
-        acc += sdf_trace(o, d, SDF_SAMPLE_WEIGHT);
-    }
+    return vec2(x, row);
+}
+
+// A 2D model: W x H samples over [-1, 1]^2 including both ends, white inside.
+float sdf_2d_pixel(vec2 px, vec2 res) {
+    return map(vec3(sdf_grid_x(int(px.x), int(res.x)), sdf_grid_y(int(px.y), int(res.y)), 0.0)) < 0.0 ? 1.0 : 0.0;
+}
+
+// Sample s of the pixel's SDF_SAMPLES: its radiance times its weight (linear, before tone mapping).
+vec3 sdf_sample_radiance(vec2 frag_coord, vec2 res, float time, vec4 orbit, vec2 pan, int s) {
+    vec2 px = sdf_setup(frag_coord, res, time, orbit, pan);
+    if (SDF_2D) return vec3(sdf_2d_pixel(px, floor(res))) * SDF_SAMPLE_WEIGHT;
+    vec2 off = sdf_sample_offset(s, SDF_SAMPLES);
+    vec3 o, d;
+    sdf_camera_ray(sdf_cam, px.x + off.x, px.y + off.y, o, d);
+    return sdf_trace(o, d, SDF_SAMPLE_WEIGHT);
+}
+
+// A pixel's radiance as display-ready colour: exposure and tone mapping, then sRGB.
+vec4 sdf_display(vec3 acc) {
     acc = vec3(acc.x >= 0.0 ? min(acc.x, 1e30) : 0.0, acc.y >= 0.0 ? min(acc.y, 1e30) : 0.0, acc.z >= 0.0 ? min(acc.z, 1e30) : 0.0);
     acc = vec3(sdf_tonemap1(acc.x, SDF_EXPOSURE, SDF_TONEMAP), sdf_tonemap1(acc.y, SDF_EXPOSURE, SDF_TONEMAP), sdf_tonemap1(acc.z, SDF_EXPOSURE, SDF_TONEMAP));
     return vec4(sdf_to_srgb(acc.x), sdf_to_srgb(acc.y), sdf_to_srgb(acc.z), 1.0);
+}
+
+// The picture at fragCoord (GL convention: origin at the bottom left), every sample.
+vec4 sdf_render(vec2 frag_coord, vec2 res, float time, vec4 orbit, vec2 pan) {
+    vec2 px = sdf_setup(frag_coord, res, time, orbit, pan);
+    if (SDF_2D) return vec4(vec3(sdf_2d_pixel(px, floor(res))), 1.0);
+    vec3 acc = vec3(0.0);
+    for (int s = sdf_zero; s < SDF_SAMPLES; ++s) {
+        vec2 off = sdf_sample_offset(s, SDF_SAMPLES);
+        vec3 o, d;
+        sdf_camera_ray(sdf_cam, px.x + off.x, px.y + off.y, o, d);
+        acc += sdf_trace(o, d, SDF_SAMPLE_WEIGHT);
+    }
+    return sdf_display(acc);
 }

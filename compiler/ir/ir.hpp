@@ -23,6 +23,21 @@ struct Node {
     float k = 0.0f;  // immediate (Const value, *_I forms)
 };
 
+// A part of the graph that an evaluator may skip: a union's child (compiler/scene/
+// shapes_csg.cpp). Where the point (nodes `point`) is outside the box [lo, hi] of the child's
+// surface and at least `thr` from it (thr: the union's distance without this child), the
+// child cannot be the nearest: `root`, its distance, may be taken as +inf without computing
+// what only it (and `extra`, its material channels) needs. Codegen turns regions into guard
+// instructions (compiler/bytecode/codegen.cpp); `parent` is the region this one lies in.
+struct GuardRegion {
+    NodeId root = kNoNode;
+    std::vector<NodeId> extra;
+    NodeId thr = kNoNode;
+    NodeId point[3] = {kNoNode, kNoNode, kNoNode};
+    float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    int32_t parent = -1;
+};
+
 class Graph {
 public:
     Graph();
@@ -68,6 +83,28 @@ public:
     // Total-node limit (script safety): exceeding it throws CompileError at the current loc.
     void set_node_limit(size_t n) { node_limit_ = n; }
 
+    // Guarded regions, made while lowering; lower_scene clears them (and the context) first,
+    // so codegen sees those of the latest lowering (and of what was lowered since).
+    int32_t add_guard(const GuardRegion& r) {
+        guards_.push_back(r);
+        return static_cast<int32_t>(guards_.size() - 1);
+    }
+    GuardRegion& guard(int32_t i) { return guards_[size_t(i)]; }
+    const std::vector<GuardRegion>& guards() const { return guards_; }
+    void clear_guards() {
+        guards_.clear();
+        guard_ctx_ = GuardContext{};
+    }
+    // What lowering passes down to the unions it meets: the distance a child must beat
+    // (kNoNode: none) and the region being lowered (-1: none). Set by unions for their
+    // children, cleared below anything that changes distances other than rigidly.
+    struct GuardContext {
+        NodeId thr = kNoNode;
+        int32_t region = -1;
+    };
+    GuardContext guard_context() const { return guard_ctx_; }
+    void set_guard_context(GuardContext c) { guard_ctx_ = c; }
+
 private:
     enum : uint8_t { kTime = 1, kPoint = 2 };
     NodeId intern(const Node& n);
@@ -81,6 +118,8 @@ private:
     std::vector<NodeId> table_;
     Loc cur_loc_;
     size_t node_limit_ = 20'000'000;
+    std::vector<GuardRegion> guards_;
+    GuardContext guard_ctx_;
 };
 
 // Readable listing of the nodes reachable from `roots` (`sdfc compile --emit ir`).

@@ -5,11 +5,12 @@ uint sdf_hash3(uint x, uint y, uint z) {
     h ^= h >> 16; h *= 0x7feb352du; h ^= h >> 15; h *= 0x846ca68bu; h ^= h >> 16;
     return h;
 }
+// (Choices by mix with a bool, not ?: or if: SwiftShader compiles branches slowly.)
 float sdf_grad3(uint h, vec3 p) {
     uint g = h & 15u;
-    float u = g < 8u ? p.x : p.y;
-    float v = g < 4u ? p.y : ((g == 12u || g == 14u) ? p.x : p.z);
-    return ((g & 1u) != 0u ? -u : u) + ((g & 2u) != 0u ? -v : v);
+    float u = mix(p.y, p.x, g < 8u);
+    float v = mix(mix(p.z, p.x, any(bvec2(g == 12u, g == 14u))), p.y, g < 4u);
+    return mix(u, -u, (g & 1u) != 0u) + mix(v, -v, (g & 2u) != 0u);
 }
 float sdf_noise(vec3 q) {
     vec3 f = floor(q);

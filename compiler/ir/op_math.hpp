@@ -11,6 +11,7 @@
 
 namespace sdfc::om {
 
+inline constexpr float kSkipped = INFINITY;  // what a skipped guarded region leaves (Op::Guard)
 inline float sqrt_(float a) { return std::sqrt(a); }
 inline float clamp1(float a) { return a < -1.0f ? -1.0f : (a > 1.0f ? 1.0f : a); }
 inline float min_(float a, float b) { return b < a ? b : a; }

@@ -50,7 +50,7 @@ inline constexpr OpInfo kOpInfo[] = {
 inline const OpInfo& op_info(Op op) { return kOpInfo[static_cast<int>(op)]; }
 
 // Inputs are set by the evaluator, not computed from operands.
-inline bool is_input(Op op) { return op == Op::VarX || op == Op::VarY || op == Op::VarZ || op == Op::Time; }
+inline bool is_input(Op op) { return op == Op::VarX || op == Op::VarY || op == Op::VarZ || op == Op::Time || op == Op::Param; }
 
 // Scalar semantics of one op (constant folding, reference evaluation).
 inline float eval_op(Op op, float a, float b, float c, float k) {

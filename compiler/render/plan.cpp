@@ -10,14 +10,6 @@
 namespace sdfc {
 namespace {
 
-float radical_inverse2(uint32_t i) {
-    i = (i << 16) | (i >> 16);
-    i = ((i & 0x55555555u) << 1) | ((i & 0xAAAAAAAAu) >> 1);
-    i = ((i & 0x33333333u) << 2) | ((i & 0xCCCCCCCCu) >> 2);
-    i = ((i & 0x0F0F0F0Fu) << 4) | ((i & 0xF0F0F0F0u) >> 4);
-    i = ((i & 0x00FF00FFu) << 8) | ((i & 0xFF00FF00u) >> 8);
-    return static_cast<float>(i) * 2.3283064365386963e-10f;
-}
 
 // A Lipschitz estimate for a raw field over a box: the largest gradient norm (forward
 // differences) on a 16^3 grid, among the tenth of the points with the smallest |f| (the far
@@ -58,12 +50,7 @@ float estimate_lipschitz(const PlanInputs& in, const glm::vec3& lo, const glm::v
 
 std::vector<glm::vec2> sample_offsets(int samples) {
     std::vector<glm::vec2> out;
-    for (int i = 0; i < samples; ++i) {
-        const float sx = (static_cast<float>(i) + 0.5f) / static_cast<float>(samples);
-        float sy = radical_inverse2(static_cast<uint32_t>(i)) + 0.5f / static_cast<float>(samples);
-        if (sy >= 1.0f) sy -= 1.0f;
-        out.emplace_back(sx, sy);
-    }
+    for (int i = 0; i < samples; ++i) out.push_back(rules::sdf_sample_offset(i, samples));
     return out;
 }
 

@@ -41,6 +41,24 @@ SDF_FN vec3 sdf_nonneg3(vec3 v) {
     return r;
 }
 
+// ---- anti-aliasing ----
+// Where sample i of n lies in its pixel: x stratified, y the base-2 radical inverse of i
+// shifted by half a stratum (a Hammersley set).
+SDF_FN vec2 sdf_sample_offset(int i, int n) {
+    uint b = uint(i);
+    b = (b << 16u) | (b >> 16u);
+    b = ((b & 0x55555555u) << 1u) | ((b & 0xAAAAAAAAu) >> 1u);
+    b = ((b & 0x33333333u) << 2u) | ((b & 0xCCCCCCCCu) >> 2u);
+    b = ((b & 0x0F0F0F0Fu) << 4u) | ((b & 0xF0F0F0F0u) >> 4u);
+    b = ((b & 0x00FF00FFu) << 8u) | ((b & 0xFF00FF00u) >> 8u);
+    float sy = float(b) * 2.3283064365386963e-10f + 0.5f / float(n);
+    if (sy >= 1.0f) sy -= 1.0f;
+    vec2 r;
+    r.x = (float(i) + 0.5f) / float(n);
+    r.y = sy;
+    return r;
+}
+
 // ---- tolerances along a ray ----
 // Hit threshold at path length `path` (relative beyond one unit), the radius of one pixel's
 // footprint (cone tracing, and "close enough" for rays out of steps), and the offset that

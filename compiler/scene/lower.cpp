@@ -47,6 +47,12 @@ Lowered lower_shape(Graph& g, const Shape& s, const Vec3N& p, const MaterialN* i
                                               s.params.size(), shape_slots(s.kind)));
     Loc saved = g.loc();
     if (s.loc.known()) g.set_loc(s.loc);
+    // A union's threshold (guards, GuardRegion) reaches unions below it through modifiers
+    // that move shapes rigidly or colour them; anything else changes what distances mean.
+    const Graph::GuardContext guards = g.guard_context();
+    const bool rigid = s.kind == ShapeKind::Union || s.kind == ShapeKind::Translate || s.kind == ShapeKind::Rotate ||
+                       s.kind == ShapeKind::Mirror || s.kind == ShapeKind::Material;
+    if (!rigid) g.set_guard_context({kNoNode, guards.region});
     L l{g};
     Lowered out;
     switch (s.kind) {
@@ -66,6 +72,7 @@ Lowered lower_shape(Graph& g, const Shape& s, const Vec3N& p, const MaterialN* i
 #undef SDFC_CALL_Csg
 #undef SDFC_CALL_Modifier
     }
+    g.set_guard_context(guards);
     g.set_loc(saved);
     return out;
 }

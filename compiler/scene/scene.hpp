@@ -143,6 +143,14 @@ struct RenderSettings {
     std::string tonemap = "none";   // mapped: "none" (clipped at 1), "reinhard" or "aces"
 };
 
+// A script's `let name = param(value, min, max, step)`: a number the html page turns with a
+// slider (a uniform, sdf_param[index]); the CPU and Shadertoy take its value (-D sets it).
+struct SceneParam {
+    std::string name;
+    float value = 0.0f, min = 0.0f, max = 1.0f, step = 0.001f;
+    Loc loc;
+};
+
 struct Scene {
     std::shared_ptr<Graph> graph;  // owns every NodeId below
     ShapePtr root;                 // union of the top-level statements (Empty if none)
@@ -157,6 +165,9 @@ struct Scene {
     // What the script does that is legal but likely not meant (an intersection of one
     // shape, an empty difference, an alpha that is ignored): the commands print them.
     std::vector<Diagnostic> warnings;
+    // The params, when they stay symbolic (GLSL: InterpretOptions::time is nullopt), in
+    // the order of their Param nodes' k.
+    std::vector<SceneParam> params;
 };
 
 // Sets the settings of LANGUAGE.md section 8's defaults (camera at [0, 0, 5] looking at

@@ -63,6 +63,7 @@ inline D sqrt_(const D& a) {
     const float s = ::std::sqrt(a.v);
     return scale(a, s, s > 0.0f ? 0.5f / s : 0.0f);
 }
+inline constexpr float kSkipped = ::sdfc::om::kSkipped;
 inline D clamp1(const D& a) { return a.v < -1.0f ? D(-1.0f) : (a.v > 1.0f ? D(1.0f) : a); }
 inline D min_(const D& a, const D& b) { return b.v < a.v ? b : a; }
 inline D max_(const D& a, const D& b) { return a.v < b.v ? b : a; }

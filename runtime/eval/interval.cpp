@@ -399,6 +399,8 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
             break;
         }
         case Op::Noise3: lo = -2.001f; hi = 2.001f; break;
+        case Op::Guard: lo = hi = INFINITY; break;  // overwritten by its region
+        case Op::Param: lo = -INFINITY; hi = INFINITY; break;  // a shader's uniform
     }
     if constexpr (P == Poison::Result) z += (lo + hi) * 0.0f;
     lo += z;

@@ -209,7 +209,7 @@ TEST_CASE("glsl: negative constants print as subtraction, never as '--'", "[glsl
 }
 
 TEST_CASE("glsl: every opcode goes through the emitter as its opcodes.def template", "[glsl][opcodes]") {
-    std::string all = "#version 300 es\nprecision highp float;\nprecision highp int;\nfloat sdf_time;\n";
+    std::string all = "#version 300 es\nprecision highp float;\nprecision highp int;\nfloat sdf_time;\nconst float sdf_param[4] = float[4](0.5, 1.0, 1.5, 2.0);\n";
     all += om::kGlslNoise;
     all += om::kGlslPow;
     std::string sum;
@@ -238,7 +238,7 @@ TEST_CASE("glsl: every opcode goes through the emitter as its opcodes.def templa
     if (!err.empty()) {
         // Name the culprits.
         for (int i = 0; i < kOpCount; ++i) {
-            const std::string one = "#version 300 es\nprecision highp float;\nprecision highp int;\nfloat sdf_time;\n" + std::string(om::kGlslNoise) + std::string(om::kGlslPow) +
+            const std::string one = "#version 300 es\nprecision highp float;\nprecision highp int;\nfloat sdf_time;\nconst float sdf_param[4] = float[4](0.5, 1.0, 1.5, 2.0);\n" + std::string(om::kGlslNoise) + std::string(om::kGlslPow) +
                                     single[i] + "out vec4 color;\nvoid main() { color = vec4(op_" + std::string(op_info(static_cast<Op>(i)).mnemonic) +
                                     "(gl_FragCoord.xyz)); }\n";
             const std::string e = validate(one, fmt::format("op_{}", i));
@@ -335,7 +335,7 @@ TEST_CASE("glsl: every sdf_ function a shader calls is defined in it, template h
 
 TEST_CASE("glsl: every function the renderer's .glsl files call is defined", "[glsl]") {
     // Builtins, constructors and keywords the renderer may use; a new builtin goes here.
-    const std::set<std::string> glsl = {"abs", "asin", "atan", "clamp", "cos", "cross", "dot", "exp", "floor", "isinf", "isnan",
+    const std::set<std::string> glsl = {"abs", "asin", "atan", "clamp", "cos", "cross", "dot", "exp", "floor", "isinf", "isnan", "all", "any", "bvec2", "bvec3",
                                         "length", "max", "min", "mix", "mod", "normalize", "pow", "radians", "reflect", "refract",
                                         "sin", "sqrt", "tan", "uintBitsToFloat", "bool", "float", "int", "uint", "vec2",
                                         "vec3", "vec4", "ivec3", "uvec3", "if", "for", "while", "return"};
@@ -439,7 +439,9 @@ TEST_CASE("glsl: the html page is self-contained", "[glsl][html]") {
     CHECK(page.find("@SHADER@") == std::string::npos);
     CHECK(page.find("@PAGE_JS@") == std::string::npos);
     CHECK(page.find("@USES_TIME@") == std::string::npos);
-    CHECK(page.find("var usesTime = false;") != std::string::npos);
+    CHECK(page.find("\"uses_time\":false") != std::string::npos);
+    CHECK(page.find("@SCENE@") == std::string::npos);
+    CHECK(page.find("id=\"samples\"") != std::string::npos);
     CHECK(page.find("capture") != std::string::npos);
     CHECK(page.find("id=\"play\"") != std::string::npos);
     CHECK(page.find("id=\"time\"") != std::string::npos);

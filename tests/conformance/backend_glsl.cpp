@@ -7,7 +7,10 @@
 #include <cmath>
 #include <cstring>
 
+#include <fmt/format.h>
+
 #include "compiler/glsl/glsl_emit.hpp"
+#include "compiler/glsl/glsl_tape.hpp"
 
 #if SDFC_HAVE_EGL
 #include "gpu/gles.hpp"
@@ -36,14 +39,24 @@ Context& context() {
     return c;
 }
 
-std::string shader(const Program& p) {
+// `tape`: the program through the tape interpreter (compiler/glsl/glsl_tape.hpp, its tape a
+// constant array) instead of straight-line code.
+std::string shader(const Program& p, bool tape) {
     glsl::FunctionSpec spec;
     spec.signature = "float sdf_case(vec3 p)";
     spec.var_prefix = "v";
     std::string s = "#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp sampler2D;\n"
-                    "uniform sampler2D sdf_points;\nuniform float sdf_time_in;\nfloat sdf_time;\nout vec4 sdf_bytes;\n";
+                    "uniform sampler2D sdf_points;\nuniform float sdf_time_in;\nfloat sdf_time;\nout vec4 sdf_bytes;\n"
+                    "const float sdf_param[4] = float[4](0.0, 0.0, 0.0, 0.0);  // (the params' values are 0)\n";
     s += glsl::op_helpers({&p});
-    s += glsl::function(p, spec);
+    if (tape) {
+        const glsl::PackedTapes t = glsl::pack_tapes({&p});
+        s += glsl::tape_interpreter(t, glsl::TapeStorage::ConstArray);
+        s += fmt::format("float sdf_case(vec3 p) {{\n    sdf_run({}, {}, p);\n    return sdf_reg[{}];\n}}\n", t.segments[0].begin,
+                         t.segments[0].end, t.segments[0].outputs.at(0));
+    } else {
+        s += glsl::function(p, spec);
+    }
     s += "void main() {\n"
          "    sdf_time = sdf_time_in;\n"
          "    uint u = floatBitsToUint(sdf_case(texelFetch(sdf_points, ivec2(gl_FragCoord.xy), 0).xyz));\n"
@@ -56,7 +69,9 @@ std::string shader(const Program& p) {
 
 std::string GlslLlvmpipe::unavailable() const { return context().why; }
 
-std::vector<float> GlslLlvmpipe::eval(const Program& p, const std::vector<Point>& pts, float time) {
+std::vector<float> GlslLlvmpipe::eval(const Program& p, const std::vector<Point>& pts, float time) { return run(p, pts, time, false); }
+
+std::vector<float> GlslLlvmpipe::run(const Program& p, const std::vector<Point>& pts, float time, bool tape) {
     Context& c = context();
     const int rows = int((pts.size() + kWidth - 1) / kWidth);
     std::vector<float> texels(size_t(kWidth) * size_t(rows) * 4, 0.0f);
@@ -68,12 +83,12 @@ std::vector<float> GlslLlvmpipe::eval(const Program& p, const std::vector<Point>
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, kWidth, rows, 0, GL_RGBA, GL_FLOAT, texels.data());
     std::vector<uint8_t> rgba;
-    error = c.gles.draw(shader(p), kWidth, rows, rgba, [&](GLuint prog) {
+    error = c.gles.draw(shader(p, tape), kWidth, rows, rgba, [&](GLuint prog) {
         glUniform1i(glGetUniformLocation(prog, "sdf_points"), 0);
         glUniform1f(glGetUniformLocation(prog, "sdf_time_in"), time);
     });
     if (!error.empty()) {
-        error += "\nshader:\n" + shader(p);
+        error += "\nshader:\n" + shader(p, tape);
         return {};
     }
     std::vector<float> out(pts.size());
@@ -89,6 +104,7 @@ std::vector<float> GlslLlvmpipe::eval(const Program& p, const std::vector<Point>
 
 std::string GlslLlvmpipe::unavailable() const { return "built without EGL/GLESv2 (Debian: libegl-dev libgles-dev)"; }
 std::vector<float> GlslLlvmpipe::eval(const Program&, const std::vector<Point>&, float) { return {}; }
+std::vector<float> GlslLlvmpipe::run(const Program&, const std::vector<Point>&, float, bool) { return {}; }
 
 #endif
 

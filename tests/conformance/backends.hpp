@@ -64,11 +64,20 @@ struct GlslLlvmpipe {
     static constexpr bool kVmFloats = false;
     std::string unavailable() const;
     std::vector<float> eval(const Program& p, const std::vector<Point>& pts, float time);  // empty: see error
+    // `tape`: through the tape interpreter (compiler/glsl/glsl_tape.hpp) instead.
+    std::vector<float> run(const Program& p, const std::vector<Point>& pts, float time, bool tape);
     std::string error;  // the last eval's shader log, when it failed
     // Where llvmpipe is known to differ from opcodes.def's semantics (results GLSL ES 3.00
     // leaves undefined, or to the implementation's precision): why, or "". The point suite
     // counts and reports these instead of failing; any other difference fails.
     static std::string known_difference(const Case& c, const Point& p, float got);
+};
+
+// The same shader's tape interpreter (compiler/glsl/glsl_tape.hpp), the program as data: what
+// big scenes' shaders run. Guards skip their regions here, which must change no value
+// (only shapes whose distance is never below their box's are guarded).
+struct GlslTapeLlvmpipe : GlslLlvmpipe {
+    std::vector<float> eval(const Program& p, const std::vector<Point>& pts, float time) { return run(p, pts, time, true); }
 };
 
 // --- box backends: an interval of output 0 over each box, and each choice op's decision ---

@@ -91,6 +91,10 @@ const std::vector<Case>& opcode_cases() {
                 out.push_back(opcode_case(op, 0.75f));
                 continue;
             }
+            if (op == Op::Param) {  // k: which param (the backends' params are all 0)
+                for (float k : {0.0f, 3.0f}) out.push_back(opcode_case(op, k));
+                continue;
+            }
             for (float k : {0.75f, -2.5f, 0.0f, 3.0f}) out.push_back(opcode_case(op, k));
         }
         return out;

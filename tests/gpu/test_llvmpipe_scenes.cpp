@@ -14,6 +14,8 @@
 //                     (shadows ao samples max_bounces max_steps max_distance epsilon aa)
 //   SDFC_DRIFT_CPU    "baseline": the CPU renders with --baseline (no tape tree, no
 //                     over-relaxation, no clipping, no tile pre-march)
+//   SDFC_DRIFT_CODE   straight, tape (the html page's shader, its tape in a texture) or
+//                     const-tape (Shadertoy's, the tape in a constant array)
 //   SDFC_DRIFT_GLSL_SUB  "FROM=>TO;...": text replaced in the shader (first occurrence), e.g.
 //                     "SDF_RELAX = 1.5=>SDF_RELAX = 1.0"
 // Run: SDFC_DRIFT_SCENE=tests/gpu/scenes/crowd.sdf build/tests/test_gpu_llvmpipe '[.drift]'
@@ -37,9 +39,9 @@ using namespace sdfc::gpu_test;
 constexpr int kWidth = 160, kHeight = 90;
 constexpr double kTargetPsnr = 45.0;
 
-std::vector<std::string> scenes() {
+std::vector<std::string> scenes(const std::string& sub = "") {
     std::vector<std::string> out;
-    const fs::path dir = fs::path(SDFC_SOURCE_DIR) / "tests" / "gpu" / "scenes";
+    const fs::path dir = fs::path(SDFC_SOURCE_DIR) / "tests" / "gpu" / "scenes" / sub;
     for (const auto& e : fs::directory_iterator(dir))
         if (e.is_regular_file() && e.path().extension() == ".sdf") out.push_back(e.path().string());
     std::sort(out.begin(), out.end());
@@ -74,8 +76,10 @@ struct Pair {
 };
 
 // `path` at width x height, at the script's samples (changed by `settings`), on both renderers.
+// `code`: how the shader holds the programs; Tape draws the html page's shader (the tape
+// in a texture) unless `const_tape`, which draws the Shadertoy one (the tape in a constant array).
 Pair render_both(Gles& gles, const std::string& path, int width, int height, const std::string& settings = "",
-                 bool cpu_baseline = false) {
+                 bool cpu_baseline = false, GlslCode code = GlslCode::Auto, bool const_tape = false) {
     Pair out;
     using clock = std::chrono::steady_clock;
     const auto t0 = clock::now();
@@ -99,7 +103,17 @@ Pair render_both(Gles& gles, const std::string& path, int width, int height, con
         o.time = std::nullopt;
         Scene s = load_scene(sm, path, o);
         apply_settings(s.render, settings);
-        glsl = emit_glsl(s, GlslTarget::Shadertoy);
+        GlslOptions go;
+        go.code = code;
+        if (code == GlslCode::Tape && !const_tape) {
+            const GlslOutput html = compile_glsl(s, GlslTarget::HtmlShader, go);
+            const std::string err = draw_html_shader(gles, html, width, height, out.gpu);
+            if (!err.empty()) throw std::runtime_error(path + ": " + err);
+            out.cpu_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+            out.gpu_ms = std::chrono::duration<double, std::milli>(clock::now() - t1).count();
+            return out;
+        }
+        glsl = compile_glsl(s, GlslTarget::Shadertoy, go).text;
     }
     if (const char* sub = std::getenv("SDFC_DRIFT_GLSL_SUB")) {  // "FROM=>TO;FROM=>TO": edits of the shader
         std::stringstream in(sub);
@@ -147,22 +161,23 @@ void save_pair(const Pair& p, const std::string& stem) {
 }
 
 // Draws each of `files` both ways and checks PSNR >= kTargetPsnr.
-void check_all(Gles& gles, const std::vector<std::string>& files) {
+void check_all(Gles& gles, const std::vector<std::string>& files, GlslCode code = GlslCode::Auto, bool const_tape = false,
+               int width = kWidth, int height = kHeight) {
     double lowest = INFINITY;
     std::string lowest_name;
     for (const std::string& path : files) {
         const std::string name = fs::path(path).stem().string();
         INFO("scene " << path);
-        const Pair p = render_both(gles, path, kWidth, kHeight);
+        const Pair p = render_both(gles, path, width, height, "", false, code, const_tape);
         const double db = psnr(p.cpu, p.gpu);
         std::printf("  %-24s PSNR %7.2f dB  %5.2f%% pixels off by > 8  (samples %d; cpu %5.0f ms, llvmpipe %6.0f ms)\n", name.c_str(),
                     db, 100.0 * bad_pixels(p.cpu, p.gpu), p.samples, p.cpu_ms, p.gpu_ms);
         std::fflush(stdout);
         if (db < lowest) lowest = db, lowest_name = name;
-        if (db < kTargetPsnr || std::getenv("SDFC_GPU_OUT")) save_pair(p, name);
+        if (db < kTargetPsnr || std::getenv("SDFC_GPU_OUT")) save_pair(p, name + (code == GlslCode::Tape ? ".tape" : ""));
         CHECK(db >= kTargetPsnr);
     }
-    std::printf("lowest PSNR: %.2f dB (%s) over %zu scenes at %dx%d\n", lowest, lowest_name.c_str(), files.size(), kWidth, kHeight);
+    std::printf("lowest PSNR: %.2f dB (%s) over %zu scenes at %dx%d\n", lowest, lowest_name.c_str(), files.size(), width, height);
 }
 
 bool start(Gles& gles) {
@@ -193,6 +208,21 @@ TEST_CASE("every example matches between the CPU and llvmpipe at its own samples
     check_all(gles, files);
 }
 
+// The tape interpreter (compiler/glsl/glsl_tape.hpp), which big scenes get (tests/gpu/scenes/big:
+// 2,047 boxes in a tree, 10,000 spheres: guards skip most of them): the html page's shader
+// with its tape in a texture, and the Shadertoy one with it in a constant array. Small
+// pictures: llvmpipe runs an interpreter's switch under lane masks, every case each turn.
+TEST_CASE("every example and big scene matches through the tape interpreter", "[gpu][llvmpipe][scenes][tape]") {
+    Gles gles;
+    if (!start(gles)) return;
+    std::vector<std::string> files = examples();
+    for (const std::string& f : scenes("big")) files.push_back(f);
+    std::printf("the html page's shader (tape texture):\n");
+    check_all(gles, files, GlslCode::Tape, false, 64, 36);
+    std::printf("Shadertoy's (constant array):\n");
+    check_all(gles, {files.front()}, GlslCode::Tape, true, 64, 36);
+}
+
 TEST_CASE("drift tool: one scene both ways, with pictures (SDFC_DRIFT_SCENE)", "[.drift]") {
     const char* scene = std::getenv("SDFC_DRIFT_SCENE");
     if (!scene || !*scene) {
@@ -206,7 +236,10 @@ TEST_CASE("drift tool: one scene both ways, with pictures (SDFC_DRIFT_SCENE)", "
     const bool baseline = cpu_env && std::string(cpu_env) == "baseline";
     Gles gles;
     if (!start(gles)) return;
-    const Pair p = render_both(gles, scene, w, h, set ? set : "", baseline);
+    const char* code_env = std::getenv("SDFC_DRIFT_CODE");  // straight, tape (the html shader) or const-tape (Shadertoy's)
+    const std::string code = code_env ? code_env : "";
+    const Pair p = render_both(gles, scene, w, h, set ? set : "", baseline,
+                               code == "straight" ? GlslCode::Straight : code.empty() ? GlslCode::Auto : GlslCode::Tape, code == "const-tape");
     const std::string stem = fs::path(scene).stem().string();
     save_pair(p, stem);
     std::printf("%s %dx%d [%s]%s: PSNR %.2f dB, %.2f%% pixels off by > 8 (cpu %.0f ms, llvmpipe %.0f ms) -> %s\n", stem.c_str(), w, h,

@@ -43,7 +43,7 @@ TEST_CASE("gradients: every opcode's derivative agrees with central differences 
     int checked = 0;
     for (int o = 0; o < kOpCount; ++o) {
         const Op op = Op(o);
-        if (op == Op::VarX || op == Op::VarY || op == Op::VarZ || op == Op::Time) continue;
+        if (op == Op::VarX || op == Op::VarY || op == Op::VarZ || op == Op::Time || op == Op::Guard) continue;  // (guard: +inf)
         int here = 0;
         for (int trial = 0; trial < 200; ++trial) {
             const float k0 = uk(rng), k = k0 < 0.0f ? std::min(k0, -0.5f) : std::max(k0, 0.5f);  // no period below a step
