@@ -203,6 +203,7 @@ constexpr size_t kMaxParams = 64;
 Value Interp::make_param(std::vector<Value>& args, const std::vector<Loc>& locs, Loc loc) {
     if (param_let.empty())
         fail(loc, "param(...) gives a top-level let its value, which the html page's slider turns: let size = param(1, 0.1, 3);");
+    if (++params_in_let > 1) fail(loc, fmt::format("'{}' has a param(...) already: one a let, each its own slider", param_let));
     if (args.empty() || args.size() > 4) fail(loc, fmt::format("param takes 1 to 4 arguments (value, min, max, step), not {}", args.size()));
     static const char* const kWhat[] = {"the param's value", "the param's min", "the param's max", "the param's step"};
     float v[4] = {0, 0, 0, 0};

@@ -136,6 +136,7 @@ public:
     void check_defines_used(Env* top);
     // param(...): the top-level let whose value is being computed ("" elsewhere).
     std::string param_let;
+    int params_in_let = 0;     // param(...) calls in param_let's value: one names its slider
     bool param_fixed = false;  // -D gave the let its value: param(...) is a number
     Value make_param(std::vector<Value>& args, const std::vector<Loc>& locs, Loc loc);
 

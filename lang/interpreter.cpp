@@ -200,6 +200,7 @@ Value Interp::defined_value(size_t k, const ast::Stmt& let, Env* env) {
         // The script's own value, for its kind: a param(...) in it is checked, not made.
         const std::string outer = param_let;
         param_let = let.name;
+        params_in_let = 0;
         param_fixed = true;
         Value own;
         try {
@@ -293,6 +294,7 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
                 // A param(...) here is named after the let (a -D value above replaces it).
                 const std::string outer = param_let;
                 param_let = env == main_env && s.kind == ast::StmtKind::Let ? s.name : "";
+                params_in_let = 0;
                 try {
                     v = eval(*s.value, env);
                 } catch (...) {

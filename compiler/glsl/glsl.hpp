@@ -21,7 +21,7 @@ enum class GlslTarget {
 // instruction), or data for the tape interpreter (compiler/glsl/glsl_tape.hpp); Auto picks
 // the tape for programs of kTapeThreshold instructions or more.
 enum class GlslCode { Auto, Straight, Tape };
-inline constexpr size_t kTapeThreshold = 10000;  // distance + shading instructions (docs/glsl.md: the measurements)
+inline constexpr size_t kTapeThreshold = 10000;  // distance + shading instructions (the measurements: docs/architecture.md)
 
 struct GlslOptions {
     GlslCode code = GlslCode::Auto;

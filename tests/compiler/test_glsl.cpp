@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -523,4 +524,26 @@ TEST_CASE("glsl: a raw field's Lipschitz estimate is the same through the batch 
     REQUIRE(at != std::string::npos);
     CHECK(std::stof(fast.substr(at + 36, 12)) == Approx(1.0f / 4.5f).epsilon(0.02));
     CHECK(fast.find("const bool SDF_RAW = true;") != std::string::npos);
+}
+
+// Issue 13's bound: a big scene's Shadertoy code, apart from the tape's data, stays at most
+// 2,000 lines, and validates inside Shadertoy's prelude.
+TEST_CASE("glsl: big scenes become a tape with bounded code", "[glsl][tape]") {
+    for (const char* stem : {"tree-2047", "grid-10000"}) {
+        INFO(stem);
+        const std::string src = read_text(fs::path(SDFC_SOURCE_DIR) / "tests/gpu/scenes/big" / (std::string(stem) + ".sdf"));
+        REQUIRE(!src.empty());
+        const std::string st = glsl_of_text(src, GlslTarget::Shadertoy);
+        const size_t open = st.find("const uvec4 SDF_TAPE[");
+        REQUIRE(open != std::string::npos);
+        const size_t close = st.find(");\n", open);
+        REQUIRE(close != std::string::npos);
+        const auto lines = [](const std::string& s) { return std::count(s.begin(), s.end(), '\n'); };
+        CHECK(lines(st) - lines(st.substr(open, close - open)) <= 2000);
+        CHECK(st.find("float map(vec3 p)") != std::string::npos);
+        if (skip_without_validator()) continue;
+        const std::string e = validate(shadertoy_prelude(st), std::string(stem) + ".shadertoy");
+        INFO(e);
+        CHECK(e == "");
+    }
 }
