@@ -169,6 +169,8 @@ std::string function(const Program& prog, const FunctionSpec& spec) {
             uses[i] == 0) {
             expr[i] = std::move(text);
         } else {
+            // The script line an instruction comes from ends its statement's line, once a line.
+            std::string note;
             const bool quiet = i < prog.locs.size() && prog.locs[i].file == spec.quiet.file && prog.locs[i].line == spec.quiet.line &&
                                prog.locs[i].col == spec.quiet.col;
             if (i < prog.locs.size() && prog.locs[i].known() && !quiet &&
@@ -178,11 +180,11 @@ std::string function(const Program& prog, const FunctionSpec& spec) {
                 std::string src = comment_text(l.file->line(l.line));
                 if (src.rfind("//", 0) == 0 || src.rfind("/*", 0) == 0) src.clear();  // a comment line: the file's top level
                 if (src.size() > 90) src = src.substr(0, 87) + "...";
-                body += fmt::format("{}// {}:{}{}{}\n", spec.indent, comment_text(std::filesystem::path(l.file->path).filename().string()),
-                                    l.line, src.empty() ? "" : "  ", src);
+                note = fmt::format("  // {}:{}{}{}", comment_text(std::filesystem::path(l.file->path).filename().string()), l.line,
+                                   src.empty() ? "" : "  ", src);
             }
             std::string name = fmt::format("{}{}", spec.var_prefix, counter++);
-            body += fmt::format("{}float {} = {};\n", spec.indent, name, strip_outer(text));
+            body += fmt::format("{}float {} = {};{}\n", spec.indent, name, strip_outer(text), note);
             expr[i] = std::move(name);
         }
         if (in.out < cur.size()) cur[in.out] = static_cast<int>(i);

@@ -274,6 +274,7 @@ TEST_CASE("glsl: every example compiles for every target", "[glsl][examples]") {
         CHECK(st.find("void mainImage(out vec4 fragColor, in vec2 fragCoord)") != std::string::npos);
         CHECK(st.find("float map(vec3 p)") != std::string::npos);
         CHECK(st.find("Material sdf_material(vec3 p)") != std::string::npos);
+        CHECK(std::count(st.begin(), st.end(), '\n') <= 2000);  // issue 13's bound on pasted code
 
         const std::string g330 = emit_glsl(s, GlslTarget::Glsl330);
         CHECK(g330.rfind("#version 330 core\n", 0) == 0);
