@@ -29,6 +29,7 @@
 #include "runtime/io/image.hpp"
 #include "runtime/cpu/slice.hpp"
 #include "runtime/cpu/tracer.hpp"
+#include "runtime/eval/isa.hpp"
 #include "runtime/eval/vm.hpp"
 
 #ifndef SDFC_VERSION
@@ -560,12 +561,12 @@ int cmd_bench(Args& a) {
     auto per = [&](uint64_t v) { return double(v) / pixels; };
     const auto& by = stats.distance_points_by;
     std::printf("median_ms=%.3f min_ms=%.3f evals_per_pixel=%.2f rays=%.2f normals=%.2f shadows=%.2f ao=%.2f "
-                "shading=%.2f tape=%.0f/%zu tree_leaves=%llu tree_ms=%.1f skips=%.2f\n",
+                "shading=%.2f tape=%.0f/%zu tree_leaves=%llu tree_ms=%.1f skips=%.2f isa=%s\n",
                 median, sorted.front(), per(stats.distance_points), per(by[RenderStats::kRays]),
                 per(by[RenderStats::kNormals]), per(by[RenderStats::kShadows]), per(by[RenderStats::kAo]),
                 per(stats.shading_points),
                 stats.distance_points ? double(stats.distance_instructions) / double(stats.distance_points) : 0.0,
-                cs.distance.code.size(), static_cast<unsigned long long>(stats.tree_leaves), stats.tree_ms, per(stats.skips));
+                cs.distance.code.size(), static_cast<unsigned long long>(stats.tree_leaves), stats.tree_ms, per(stats.skips), isa_name(current_isa()));
     return 0;
 }
 
@@ -599,7 +600,8 @@ int dispatch(const std::vector<std::string>& all) {
     }
     if (all[0] == "--help" || all[0] == "-h") return write_stdout(global_help()), 0;
     if (all[0] == "--version") {
-        std::printf("sdfc %s\n", SDFC_VERSION);
+        // The batch kernels in use (runtime/eval/isa.hpp; SDFC_ISA=baseline|avx2|avx512 caps them).
+        std::printf("sdfc %s (kernels: %s)\n", SDFC_VERSION, isa_name(current_isa()));
         return 0;
     }
     std::string cmd = all[0];

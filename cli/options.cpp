@@ -159,7 +159,7 @@ std::vector<CommandSpec> make_commands() {
                       },
                       render_settings()),
                  "Prints median_ms, min_ms, evals_per_pixel (SDF evaluations: rays, normals, shadows, ao), shading (material "
-                 "evaluations), the mean program length run (tape=MEAN/FULL) and the tape tree.",
+                 "evaluations), the mean program length run (tape=MEAN/FULL), the tape tree and the kernels' instruction set (isa).",
                  true});
     c.push_back({"watch", "[--runs N] [--debounce MS] CMD ARGS...", "run a command again on every save of its scene or an import",
                  {

@@ -15,10 +15,12 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <new>
 #include <span>
 
+#include "runtime/eval/isa.hpp"
 #include "runtime/eval/simd.hpp"
 
 // A new opcode must get its interval semantics here: a missing case is an error.
@@ -417,6 +419,39 @@ float* alloc_floats(size_t count) {  // uninitialised: a register is written bef
 
 }  // namespace
 
+// The kernel for each instruction set the build carries (runtime/eval/isa.hpp).
+namespace iv_baseline {
+#include "runtime/eval/interval_kernel.inl"
+}  // namespace iv_baseline
+#if defined(SDFC_ISA_DISPATCH)
+SDFC_ISA_BEGIN_AVX2
+namespace iv_avx2 {
+#include "runtime/eval/interval_kernel.inl"
+}  // namespace iv_avx2
+SDFC_ISA_END
+SDFC_ISA_BEGIN_AVX512
+namespace iv_avx512 {
+#include "runtime/eval/interval_kernel.inl"
+}  // namespace iv_avx512
+SDFC_ISA_END
+#endif
+
+namespace {
+using RunFn = void (*)(const TapeView&, float*, float*, uint8_t*, const float*, const float*, const float*, const float*,
+                       const float*, const float*, int, int, float);
+const RunFn kKernels[] = {
+    iv_baseline::run,
+#if defined(SDFC_ISA_DISPATCH)
+    iv_avx2::run,
+    iv_avx512::run,
+#endif
+};
+RunFn kernels() {
+    const int i = static_cast<int>(current_isa());
+    return kKernels[i < int(std::size(kKernels)) ? i : 0];
+}
+}  // namespace
+
 Interval eval_interval(Op op, Interval a, Interval b, Interval c, float k, uint8_t* choice) {
     Interval r{};
     uint8_t ch = kChoiceBoth;
@@ -464,65 +499,7 @@ void IntervalEvaluator::eval(const TapeView& t, const float* xlo, const float* x
     const int m = (n + 7) / 8 * 8;  // lanes computed (whole vectors); padding copies lane n-1
     stride_ = m;
     out_ = t.output(0);
-    float* const L = lo_;
-    float* const H = hi_;
-    uint8_t* chp = choices_.get();
-    auto input = [&](const Instr& in, const float* l, const float* h) {
-        float* rl = L + size_t(in.out) * kIvLanes;
-        float* rh = H + size_t(in.out) * kIvLanes;
-        for (int i = 0; i < m; ++i) {
-            int j = i < n ? i : n - 1;
-            rl[i] = l[j];
-            rh[i] = h[j];
-        }
-    };
-    for (const Instr& in : std::span(t.code, t.len)) {
-        float* rl = L + size_t(in.out) * kIvLanes;
-        float* rh = H + size_t(in.out) * kIvLanes;
-        const float* al = L + size_t(in.a) * kIvLanes;
-        const float* ah = H + size_t(in.a) * kIvLanes;
-        const float* bl = L + size_t(in.b) * kIvLanes;
-        const float* bh = H + size_t(in.b) * kIvLanes;
-        const float* cl = L + size_t(in.c) * kIvLanes;
-        const float* chh = H + size_t(in.c) * kIvLanes;
-        const float k = in.k;
-        switch (in.op) {
-#define OP(name, mn, ar, imm, choice_, poison_, sem, glsl)                                                    \
-    case Op::name:                                                                          \
-        if constexpr (Op::name == Op::VarX) input(in, xlo, xhi);                            \
-        else if constexpr (Op::name == Op::VarY) input(in, ylo, yhi);                       \
-        else if constexpr (Op::name == Op::VarZ) input(in, zlo, zhi);                       \
-        else if constexpr (Op::name == Op::Time) {                                          \
-            std::fill_n(rl, m, time);                                                       \
-            std::fill_n(rh, m, time);                                                       \
-        } else {                                                                            \
-            if constexpr (is_choice_op(Op::name)) {                                         \
-                SDFC_IVDEP                                                                  \
-                for (int i = 0; i < m; ++i) {                                               \
-                    uint8_t c;                                                              \
-                    float lo, hi;                                                           \
-                    iv<Op::name>(al[i], ah[i], bl[i], bh[i], cl[i], chh[i], k, lo, hi, c);  \
-                    rl[i] = lo;                                                             \
-                    rh[i] = hi;                                                             \
-                    chp[i] = c;                                                             \
-                }                                                                           \
-                chp += m;                                                                   \
-            } else {                                                                        \
-                SDFC_IVDEP                                                                  \
-                for (int i = 0; i < m; ++i) {                                               \
-                    uint8_t c;                                                              \
-                    float lo, hi;                                                           \
-                    iv<Op::name>(al[i], ah[i], bl[i], bh[i], cl[i], chh[i], k, lo, hi, c);  \
-                    rl[i] = lo;                                                             \
-                    rh[i] = hi;                                                             \
-                }                                                                           \
-            }                                                                               \
-        }                                                                                   \
-        break;
-#include "compiler/ir/opcodes.def"
-#undef OP
-        }
-    }
+    kernels()(t, lo_, hi_, choices_.get(), xlo, xhi, ylo, yhi, zlo, zhi, n, m, time);
 }
 
 }  // namespace sdfc

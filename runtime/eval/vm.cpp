@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <new>
 
+#include "runtime/eval/isa.hpp"
 #include "runtime/eval/simd.hpp"
 
 namespace sdfc {
@@ -37,77 +39,49 @@ void BatchVM::reserve(uint32_t regs) {
     max_regs_ = regs;
 }
 
-// One pass over the program with the lane count M known at compile time when FULL (the
-// loops unroll completely) or given at run time (m, a multiple of kGroup) otherwise.
-// Dispatch is a computed goto with one indirect jump per handler (GCC/clang), which the
-// branch predictor learns per opcode, or a switch elsewhere.
-template <bool FULL>
-static inline void run(const Instr* code, const Instr* end, float* base, const float* x, const float* y,
-                       const float* z, int n, int m_rt, float time) {
-    const int m = FULL ? kBatch : m_rt;
-    auto load = [&](float* R, const float* src) {
-        std::memcpy(R, src, sizeof(float) * static_cast<size_t>(n));
-        for (int i = n; i < m; ++i) R[i] = src[n - 1];  // keep padding lanes finite
-    };
-    const Instr* ip = code;
-    if (ip == end) return;
-#if defined(__GNUC__)
-    static const void* const labels[] = {
-#define OP(name, mn, ar, imm, choice_, poison_, sem, glsl) &&L_##name,
-#include "compiler/ir/opcodes.def"
-#undef OP
-    };
-#define SDFC_NEXT                     \
-    do {                              \
-        if (++ip == end) return;      \
-        goto* labels[int(ip->op)];    \
-    } while (0)
-    goto* labels[int(ip->op)];
-#define SDFC_CASE(name) L_##name:
-#else
-#define SDFC_NEXT break
-#define SDFC_CASE(name) case Op::name:
-    for (; ip != end; ++ip)
-        switch (ip->op) {
+// The kernel for each instruction set the build carries (runtime/eval/isa.hpp).
+namespace isa_baseline {
+#include "runtime/eval/vm_kernel.inl"
+}  // namespace isa_baseline
+#if defined(SDFC_ISA_DISPATCH)
+SDFC_ISA_BEGIN_AVX2
+namespace isa_avx2 {
+#include "runtime/eval/vm_kernel.inl"
+}  // namespace isa_avx2
+SDFC_ISA_END
+SDFC_ISA_BEGIN_AVX512
+namespace isa_avx512 {
+#include "runtime/eval/vm_kernel.inl"
+}  // namespace isa_avx512
+SDFC_ISA_END
 #endif
-#define OP(name, mn, ar, imm, choice_, poison_, sem, glsl)                                           \
-    SDFC_CASE(name) {                                                              \
-        float* R = base + static_cast<size_t>(ip->out) * kBatch;                   \
-        [[maybe_unused]] const float* A = base + static_cast<size_t>(ip->a) * kBatch; \
-        [[maybe_unused]] const float* B = base + static_cast<size_t>(ip->b) * kBatch; \
-        [[maybe_unused]] const float* C = base + static_cast<size_t>(ip->c) * kBatch; \
-        [[maybe_unused]] const float k = ip->k;                                    \
-        if constexpr (Op::name == Op::VarX) load(R, x);                            \
-        else if constexpr (Op::name == Op::VarY) load(R, y);                       \
-        else if constexpr (Op::name == Op::VarZ) load(R, z);                       \
-        else if constexpr (Op::name == Op::Time) std::fill_n(R, m, time);          \
-        else {                                                                     \
-            SDFC_IVDEP                                                             \
-            for (int i = 0; i < m; ++i) {                                          \
-                [[maybe_unused]] const float a = A[i];                             \
-                [[maybe_unused]] const float b = B[i];                             \
-                [[maybe_unused]] const float c = C[i];                             \
-                R[i] = (sem);                                                      \
-            }                                                                      \
-        }                                                                          \
-    }                                                                              \
-    SDFC_NEXT;
-#include "compiler/ir/opcodes.def"
-#undef OP
-#if !defined(__GNUC__)
-        }
+
+namespace {
+using RunFn = void (*)(const Instr*, const Instr*, float*, const float*, const float*, const float*, int, int, float);
+struct Kernels {
+    RunFn full, part;
+};
+const Kernels kKernels[] = {
+    {isa_baseline::run_full, isa_baseline::run_part},
+#if defined(SDFC_ISA_DISPATCH)
+    {isa_avx2::run_full, isa_avx2::run_part},
+    {isa_avx512::run_full, isa_avx512::run_part},
 #endif
-#undef SDFC_NEXT
-#undef SDFC_CASE
+};
+const Kernels& kernels() {
+    const int i = static_cast<int>(current_isa());
+    return kKernels[i < int(std::size(kKernels)) ? i : 0];
 }
+}  // namespace
 
 void BatchVM::eval(const TapeView& t, const float* x, const float* y, const float* z, int n, float time) {
     if (n <= 0) return;
     if (t.num_regs > max_regs_) reserve(t.num_regs);
     const int m = (n + kGroup - 1) / kGroup * kGroup;  // lanes computed
     const Instr* end = t.code + t.len;
-    if (m == kBatch) run<true>(t.code, end, regs_, x, y, z, n, m, time);
-    else run<false>(t.code, end, regs_, x, y, z, n, m, time);
+    const Kernels& k = kernels();
+    if (m == kBatch) k.full(t.code, end, regs_, x, y, z, n, m, time);
+    else k.part(t.code, end, regs_, x, y, z, n, m, time);
 }
 
 void sample_batch(const Program& p, const float* x, const float* y, const float* z, size_t n, float time, float* out) {

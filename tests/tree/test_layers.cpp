@@ -64,7 +64,7 @@ std::vector<std::string> source_files() {
         for (const auto& e : fs::recursive_directory_iterator(kRoot / top)) {
             if (!e.is_regular_file()) continue;
             const std::string ext = e.path().extension().string();
-            if (ext == ".cpp" || ext == ".hpp" || ext == ".h" || ext == ".def" || ext == ".glsl" || ext == ".html" ||
+            if (ext == ".cpp" || ext == ".hpp" || ext == ".h" || ext == ".def" || ext == ".inl" || ext == ".glsl" || ext == ".html" ||
                 ext == ".js")
                 out.push_back(fs::relative(e.path(), kRoot).generic_string());
         }
@@ -82,7 +82,7 @@ std::vector<std::string> lines_of(const std::string& rel) {
 
 bool is_cxx(const std::string& rel) {
     const std::string ext = fs::path(rel).extension().string();
-    return ext == ".cpp" || ext == ".hpp" || ext == ".h" || ext == ".def";
+    return ext == ".cpp" || ext == ".hpp" || ext == ".h" || ext == ".def" || ext == ".inl";
 }
 
 }  // namespace

@@ -1,0 +1,62 @@
+// The interval evaluator's kernel: included by interval.cpp once per instruction set, each
+// copy in its own namespace (runtime/eval/isa.hpp); no include guard on purpose.
+
+void run(const TapeView& t, float* const L, float* const H, uint8_t* chp, const float* xlo, const float* xhi, const float* ylo,
+         const float* yhi, const float* zlo, const float* zhi, int n, int m, float time) {
+    auto input = [&](const Instr& in, const float* l, const float* h) {
+        float* rl = L + size_t(in.out) * kIvLanes;
+        float* rh = H + size_t(in.out) * kIvLanes;
+        for (int i = 0; i < m; ++i) {
+            int j = i < n ? i : n - 1;
+            rl[i] = l[j];
+            rh[i] = h[j];
+        }
+    };
+    for (const Instr& in : std::span(t.code, t.len)) {
+        float* rl = L + size_t(in.out) * kIvLanes;
+        float* rh = H + size_t(in.out) * kIvLanes;
+        const float* al = L + size_t(in.a) * kIvLanes;
+        const float* ah = H + size_t(in.a) * kIvLanes;
+        const float* bl = L + size_t(in.b) * kIvLanes;
+        const float* bh = H + size_t(in.b) * kIvLanes;
+        const float* cl = L + size_t(in.c) * kIvLanes;
+        const float* chh = H + size_t(in.c) * kIvLanes;
+        const float k = in.k;
+        switch (in.op) {
+#define OP(name, mn, ar, imm, choice_, poison_, sem, glsl)                                                    \
+    case Op::name:                                                                          \
+        if constexpr (Op::name == Op::VarX) input(in, xlo, xhi);                            \
+        else if constexpr (Op::name == Op::VarY) input(in, ylo, yhi);                       \
+        else if constexpr (Op::name == Op::VarZ) input(in, zlo, zhi);                       \
+        else if constexpr (Op::name == Op::Time) {                                          \
+            std::fill_n(rl, m, time);                                                       \
+            std::fill_n(rh, m, time);                                                       \
+        } else {                                                                            \
+            if constexpr (is_choice_op(Op::name)) {                                         \
+                SDFC_IVDEP                                                                  \
+                for (int i = 0; i < m; ++i) {                                               \
+                    uint8_t c;                                                              \
+                    float lo, hi;                                                           \
+                    iv<Op::name>(al[i], ah[i], bl[i], bh[i], cl[i], chh[i], k, lo, hi, c);  \
+                    rl[i] = lo;                                                             \
+                    rh[i] = hi;                                                             \
+                    chp[i] = c;                                                             \
+                }                                                                           \
+                chp += m;                                                                   \
+            } else {                                                                        \
+                SDFC_IVDEP                                                                  \
+                for (int i = 0; i < m; ++i) {                                               \
+                    uint8_t c;                                                              \
+                    float lo, hi;                                                           \
+                    iv<Op::name>(al[i], ah[i], bl[i], bh[i], cl[i], chh[i], k, lo, hi, c);  \
+                    rl[i] = lo;                                                             \
+                    rh[i] = hi;                                                             \
+                }                                                                           \
+            }                                                                               \
+        }                                                                                   \
+        break;
+#include "compiler/ir/opcodes.def"
+#undef OP
+        }
+    }
+}
