@@ -16,6 +16,16 @@ inline std::string shadertoy_wrap(const std::string& code) {
            code + "\nvoid main() { mainImage(sdf_shadertoy_out, gl_FragCoord.xy); }\n";
 }
 
+// GL's RGBA rows (row 0 at the bottom) as RGB rows from the top.
+inline Rgb8 rgb_top_down(const std::vector<uint8_t>& rgba, int width, int height) {
+    Rgb8 out{width, height, std::vector<uint8_t>(static_cast<size_t>(width) * height * 3)};
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            for (int c = 0; c < 3; ++c)
+                out.px[(static_cast<size_t>(y) * width + x) * 3 + c] = rgba[(static_cast<size_t>(height - 1 - y) * width + x) * 4 + c];
+    return out;
+}
+
 // Draws `frag` with Shadertoy's uniforms at width x height (time 0, mouse up); fills `out`
 // (row 0 at the top). Returns the compile or link log on failure, else "".
 inline std::string draw_shadertoy(Gles& gles, const std::string& frag, int width, int height, Rgb8& out) {
@@ -26,11 +36,7 @@ inline std::string draw_shadertoy(Gles& gles, const std::string& frag, int width
         glUniform4f(glGetUniformLocation(prog, "iMouse"), 0.0f, 0.0f, 0.0f, 0.0f);
     });
     if (!err.empty()) return err;
-    out = Rgb8{width, height, std::vector<uint8_t>(static_cast<size_t>(width) * height * 3)};
-    for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x)
-            for (int c = 0; c < 3; ++c)
-                out.px[(static_cast<size_t>(y) * width + x) * 3 + c] = rgba[(static_cast<size_t>(height - 1 - y) * width + x) * 4 + c];
+    out = rgb_top_down(rgba, width, height);
     return "";
 }
 
@@ -101,11 +107,7 @@ inline std::string draw_html_shader(Gles& gles, const GlslOutput& shader, int wi
     if (sum_fbo) glDeleteFramebuffers(1, &sum_fbo);
     if (!err.empty()) return err;
     if (!fail.empty()) return fail;
-    out = Rgb8{width, height, std::vector<uint8_t>(static_cast<size_t>(width) * height * 3)};
-    for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x)
-            for (int c = 0; c < 3; ++c)
-                out.px[(static_cast<size_t>(y) * width + x) * 3 + c] = rgba[(static_cast<size_t>(height - 1 - y) * width + x) * 4 + c];
+    out = rgb_top_down(rgba, width, height);
     return "";
 }
 
