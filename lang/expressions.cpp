@@ -55,6 +55,7 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                 v.fn = fn;
                 return v;
             }
+            if (failed_lets.count(e.text)) throw CompileError(std::vector<Diagnostic>{});  // its error is out already
             if (std::string hint = habit_hint(e.text); !hint.empty()) fail(e.loc, fmt::format("unknown name '{}'{}", e.text, hint));
             std::vector<std::string> names = builtin_names();
             for (Env* s = env; s; s = s->parent)

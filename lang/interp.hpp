@@ -5,6 +5,7 @@
 #include <deque>
 #include <functional>
 #include <optional>
+#include <set>
 #include <string_view>
 #include <unordered_map>
 #include <unordered_set>
@@ -131,6 +132,9 @@ public:
 
     // -D: the main script's top-level env, which defines were used, and the override.
     Env* main_env = nullptr;
+    // Top-level lets whose value failed (reported once): a use of one is skipped quietly, not
+    // reported again as an unknown name.
+    std::set<std::string> failed_lets;
     std::vector<bool> define_used;
     Value defined_value(size_t k, const ast::Stmt& let, Env* env);
     void check_defines_used(Env* top);

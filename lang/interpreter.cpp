@@ -175,6 +175,8 @@ Scene Interp::run(const SourceFile& file) {
             exec(*st, top, shapes);
         } catch (const CompileError& e) {
             errors.insert(errors.end(), e.diagnostics().begin(), e.diagnostics().end());
+            if ((st->kind == ast::StmtKind::Let || st->kind == ast::StmtKind::Var) && !top->vars.count(st->name))
+                failed_lets.insert(st->name);
             if (errors.size() >= 20) break;
         }
     }

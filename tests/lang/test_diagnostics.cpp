@@ -94,6 +94,18 @@ TEST_CASE("several independent errors are all reported") {
     CHECK(e.find("test.sdf:3:1: error: missing argument 'minor' of torus") != std::string::npos);
 }
 
+TEST_CASE("a let whose value failed is reported once, not again at each use") {
+    CHECK(error_of("let b = sqrt(\"x\");\nsphere(b);\nbox(b);\n") ==
+          "test.sdf:1:14: error: argument 1 of sqrt must be a number or a vector, not a string\n"
+          "let b = sqrt(\"x\");\n"
+          "             ^\n");
+    // Other errors of the script are still found; an unknown name is still one.
+    const std::string e = error_of("let b = sqrt(\"x\");\nsphere(b);\ntorus(1);\nsphere(c);\n");
+    CHECK(e.find("test.sdf:3:1: error: missing argument 'minor' of torus") != std::string::npos);
+    CHECK(e.find("test.sdf:4:8: error: unknown name 'c'") != std::string::npos);
+    CHECK(e.find("'b'") == std::string::npos);
+}
+
 TEST_CASE("var is for field blocks, let cannot be reassigned") {
     CHECK(first_error_line("var x = 1;") == "test.sdf:1:1: error: 'var' is only allowed inside a field block; use 'let' for a constant");
     CHECK(first_error_line("field (p) -> { let d = 1; d = 2; d };") ==
