@@ -92,18 +92,6 @@ std::vector<Sel> select(const Graph& g, const std::vector<uint8_t>& live, const 
     return sel;
 }
 
-std::vector<uint8_t> reach(const Graph& g, const std::vector<NodeId>& from) {
-    std::vector<uint8_t> live(g.size(), 0);
-    for (NodeId r : from) live[r] = 1;
-    for (size_t i = g.size(); i-- > 0;) {
-        if (!live[i]) continue;
-        const Node& nd = g.node(static_cast<NodeId>(i));
-        for (NodeId arg : {nd.a, nd.b, nd.c})
-            if (arg != kNoNode) live[arg] = 1;
-    }
-    return live;
-}
-
 }  // namespace
 
 Program codegen(const Graph& g, const std::vector<NodeId>& roots, const std::vector<std::string>& names) {
@@ -113,22 +101,20 @@ Program codegen(const Graph& g, const std::vector<NodeId>& roots, const std::vec
     const std::vector<GuardRegion>& G = g.guards();
     std::vector<int32_t> regions;
     std::vector<NodeId> guard_inputs;
-    {
-        const std::vector<uint8_t> live0 = reach(g, roots);
-        for (size_t r = 0; r < G.size() && r < 0xFFFF; ++r) {
-            const GuardRegion& gr = G[r];
-            if (gr.root >= n || !live0[gr.root] || gr.thr >= n) continue;
-            bool ok = true;
-            for (NodeId q : gr.point) ok &= q < n;
-            if (!ok) continue;
-            regions.push_back(int32_t(r));
-            guard_inputs.push_back(gr.thr);
-            for (NodeId q : gr.point) guard_inputs.push_back(q);
-        }
+    const std::vector<uint8_t> live0 = reachable(g, roots);
+    for (size_t r = 0; r < G.size() && r < 0xFFFF; ++r) {
+        const GuardRegion& gr = G[r];
+        if (gr.root >= n || !live0[gr.root] || gr.thr >= n) continue;
+        bool ok = true;
+        for (NodeId q : gr.point) ok &= q < n;
+        if (!ok) continue;
+        regions.push_back(int32_t(r));
+        guard_inputs.push_back(gr.thr);
+        for (NodeId q : gr.point) guard_inputs.push_back(q);
     }
     std::vector<NodeId> from = roots;
     from.insert(from.end(), guard_inputs.begin(), guard_inputs.end());
-    std::vector<Sel> sel = select(g, reach(g, from), roots, guard_inputs);
+    std::vector<Sel> sel = select(g, regions.empty() ? live0 : reachable(g, from), roots, guard_inputs);
     std::vector<uint8_t> emit(n, 0);
     std::vector<std::array<NodeId, 3>> args(n, {kNoNode, kNoNode, kNoNode});
     for (size_t i = 0; i < n; ++i)
@@ -136,7 +122,7 @@ Program codegen(const Graph& g, const std::vector<NodeId>& roots, const std::vec
     std::vector<ScheduleStep> steps = schedule_guarded(g, emit, args, roots, regions);
     if (steps.empty()) {
         // Node order without guards: only what the outputs need.
-        if (!regions.empty()) sel = select(g, reach(g, roots), roots, {});
+        if (!regions.empty()) sel = select(g, live0, roots, {});
         for (size_t i = 0; i < n; ++i)
             if (sel[i].emit && !(g.is_const(NodeId(i)) && std::find(roots.begin(), roots.end(), i) == roots.end()))
                 steps.push_back({ScheduleStep::Node, uint32_t(i)});

@@ -149,15 +149,20 @@ NodeId Graph::ternary(Op op, NodeId a, NodeId b, NodeId c) {
 
 NodeId Graph::with_imm(Op op, NodeId a, NodeId b, float k) { return intern(Node{op, a, b, kNoNode, k}); }
 
-std::string dump_ir(const Graph& g, const std::vector<NodeId>& roots, const std::vector<std::string>& root_names) {
+std::vector<uint8_t> reachable(const Graph& g, const std::vector<NodeId>& roots) {
     std::vector<uint8_t> live(g.size(), 0);
     for (NodeId r : roots) live[r] = 1;
-    for (size_t i = g.size(); i-- > 0;) {
+    for (size_t i = g.size(); i-- > 0;) {  // arguments come before their users
         if (!live[i]) continue;
         const Node& n = g.node(static_cast<NodeId>(i));
         for (NodeId arg : {n.a, n.b, n.c})
             if (arg != kNoNode) live[arg] = 1;
     }
+    return live;
+}
+
+std::string dump_ir(const Graph& g, const std::vector<NodeId>& roots, const std::vector<std::string>& root_names) {
+    const std::vector<uint8_t> live = reachable(g, roots);
     std::string out;
     for (size_t i = 0; i < g.size(); ++i) {
         if (!live[i]) continue;

@@ -122,6 +122,9 @@ private:
     GuardContext guard_ctx_;
 };
 
+// 1 for each node `roots` read, directly or through others (the roots included), else 0.
+std::vector<uint8_t> reachable(const Graph& g, const std::vector<NodeId>& roots);
+
 // Readable listing of the nodes reachable from `roots` (`sdfc compile --emit ir`).
 std::string dump_ir(const Graph& g, const std::vector<NodeId>& roots, const std::vector<std::string>& root_names);
 
