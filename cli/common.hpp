@@ -57,4 +57,8 @@ int cmd_preview(Args& a);
 // `sdfc watch` (watch_command.cpp): `run` runs one command line, its errors reported.
 int cmd_watch(const std::vector<std::string>& args, int (*run)(const std::vector<std::string>&));
 
+// Called first by the thread that runs the command: its heap in transparent huge pages where
+// the kernel offers them (cli/heap.cpp: a big script's check is mostly page faults otherwise).
+void use_big_pages();
+
 }  // namespace sdfc::cli

@@ -680,7 +680,11 @@ int main(int argc, char** argv) {
     int rc = 1;
     const size_t stack = std::min(sdfc::max_thread_stack(), size_t(1) << 30);
     sdfc::install_temp_cleanup();
-    if (!sdfc::run_on_new_stack(stack, [&] { rc = finish_stdout(run(argc, argv)); })) rc = finish_stdout(run(argc, argv));
+    auto work = [&] {
+        sdfc::cli::use_big_pages();  // (the heap of the thread that parses and compiles)
+        rc = finish_stdout(run(argc, argv));
+    };
+    if (!sdfc::run_on_new_stack(stack, work)) work();
     errno = 0;
     if (std::fclose(stdout) != 0) {
         sdfc::cli::report_stdout_error(errno);

@@ -14,7 +14,7 @@ namespace sdfc {
 
 struct Instr {
     Op op;
-    uint8_t pad = 0;
+    uint8_t pad = 0;  // evaluator hints (runtime/eval/tape.hpp: kSignOnly); the VM ignores them
     uint16_t out = 0, a = 0, b = 0, c = 0;
     float k = 0.0f;
 };
@@ -24,6 +24,7 @@ static_assert(sizeof(Instr) == 16);
 // file of num_regs), so one evaluator runs any tape that fits, Fidget's model. A Program,
 // an interval Tape and a simplified leaf tape (runtime/eval/tape.hpp, simplify.hpp) each give
 // one with view(); the view borrows their storage.
+struct Guard;
 struct TapeView {
     static constexpr uint32_t kUncounted = 0xFFFFFFFFu;
     const Instr* code = nullptr;
@@ -32,6 +33,10 @@ struct TapeView {
     uint32_t num_outputs = 0;
     uint32_t num_regs = 0;              // registers the code uses (0: unknown, the caller sized the evaluator)
     uint32_t choices = kUncounted;      // min/max/select ops in code: interval choice slots
+    // The Program's guards (Guard below), for code that is a Program's own: the batch VM then
+    // skips guarded regions that every point of a batch is far from. Null for shortened
+    // tapes (their guards' ends no longer hold): those run through.
+    const Guard* guards = nullptr;
     uint16_t output(uint32_t i = 0) const { return outputs[i]; }
 };
 
@@ -62,7 +67,8 @@ struct Program {
     bool uses_time = false;
 
     TapeView view() const {
-        return {code.data(), uint32_t(code.size()), outputs.data(), uint32_t(outputs.size()), num_regs};
+        return {code.data(), uint32_t(code.size()), outputs.data(), uint32_t(outputs.size()), num_regs,
+                TapeView::kUncounted, guards.empty() ? nullptr : guards.data()};
     }
 };
 

@@ -46,6 +46,7 @@ template <class Use>
 inline Instr emit_backward(RegPool& pool, const Instr& in, uint16_t X, Use&& use) {
     pool.release(X);
     Instr e{in.op};
+    e.pad = in.pad;
     e.out = X;
     e.k = in.k;
     const int ar = kOpInfo[int(in.op)].arity;

@@ -6,14 +6,17 @@
 //   Each level evaluates all children of a tile at once (one interval lane per child, see
 //   runtime/eval/interval.hpp) with the tile's tape. A child whose interval is < 0 is filled
 //   white; one >= 0 stays black (the image starts black); the others get their own shorter
-//   tape (simplify_batch: all children of a tile in one pass) and are subdivided. A leaf is
+//   tape (simplify_batch: all children of a tile in one pass) and are subdivided. Only the
+//   sign of the output matters, so min/max ops are also decided by sign (kSignOnly in
+//   runtime/eval/tape.hpp): a shape positive over a tile leaves a union there even where
+//   its interval overlaps a straddling shape's. A leaf is
 //   one 64-lane VM batch of its tape (a "trace": the parent's live instructions).
 //   The two top levels run their children as oneTBB tasks, each with scratch from a pool
 //   (not per thread: a thread waiting in a nested parallel_for may run another task).
 //
 // Exactness: the interval bounds enclose the VM's float results bit for bit, and a
-// simplified tape computes the same floats as its parent inside its tile, so the image is
-// identical to brute-force evaluation (tests/runtime/test_raster2d.cpp, pixel by pixel).
+// simplified tape computes, inside its tile, floats with the same sign (< 0 or not) as its
+// parent's, so the image is identical to brute-force evaluation (tests/runtime/test_raster2d.cpp, pixel by pixel).
 #include <algorithm>
 #include <atomic>
 #include <memory>
@@ -318,6 +321,7 @@ Image render_2d(const CompiledScene& scene, int w, int h, int threads, bool base
     tbb::parallel_invoke([&] { img = Image(w, h, 1); },
                          [&] {
                              root = Tape::from(prog, 0);
+                             root.mark_sign_only();  // a pixel only asks "< 0"
                              pool = std::make_unique<Pool>(prog, root);
                              c.pool = pool.get();
                              s = pool->acquire();

@@ -49,8 +49,23 @@ struct TreeCell {
     // An empty (or solid) cell that will not be split runs its parent's tape (valid in the
     // parent's box, hence in its own): ref_cell is the parent.
     uint32_t ref_cell = kNone;
+    // Split axes (bit a: axis a halved). A cell is split only along axes at least half as
+    // long as its longest, so cells stay roughly cubic: a flat scene's thin layer is not
+    // cut into slabs that each cost a full split. Children on the upper side of an unsplit
+    // axis are `unused`: descents never reach them (their split coordinate is +inf).
+    uint8_t axes = 7;
+    bool unused = false;
     Tape tape;
 };
+
+// The axes a cell is split along: those at least half as long as its longest.
+uint8_t split_axes(const TreeCell& c) {
+    const glm::vec3 e = c.hi - c.lo;
+    const float m = rules::sdf_max3(e);
+    uint8_t axes = 0;
+    for (int a = 0; a < 3; ++a) axes |= uint8_t(e[a] >= 0.5f * m) << a;
+    return axes ? axes : uint8_t(7);  // (NaN extents: all, as before)
+}
 
 // Empty (ivlo > 0) or solid (ivhi < 0): no surface inside.
 bool settled(float ivlo, float ivhi) { return ivlo > 0.0f || ivhi < 0.0f; }
@@ -62,7 +77,7 @@ bool near_surface(const TreeCell& c) {
 }
 
 bool want_split(const TreeCell& c) {
-    if (c.ref_cell != kNone) return false;
+    if (c.ref_cell != kNone || c.unused) return false;
     if (c.depth >= kTreeMaxDepth || c.tape.code.size() <= kTreeLeafTape || c.stall >= kTreeMaxStall) return false;
     const float size = rules::sdf_max3(c.hi - c.lo);
     if (!(size > 0.0f) || !std::isfinite(size)) return false;
@@ -113,7 +128,7 @@ public:
         checked_ = true;
         size_t n = 0, len = 0;
         for (size_t i = 0; i < cells_.size(); ++i)
-            if (first_child_[i] == kNone && cells_[i].ref_cell == kNone && !settled(cells_[i].ivlo, cells_[i].ivhi))
+            if (first_child_[i] == kNone && cells_[i].ref_cell == kNone && !cells_[i].unused && !settled(cells_[i].ivlo, cells_[i].ivhi))
                 ++n, len += cells_[i].tape.code.size();
         return n > 0 && static_cast<double>(len) > kTreeUseless * static_cast<double>(n) * static_cast<double>(p_.code.size());
     }
@@ -190,12 +205,13 @@ void TreeBuilder::split(TreeScratch& s, uint32_t i) {
     TreeCell& c = cells_[i];
     const uint32_t first = first_child_[i];
     const glm::vec3 mid = 0.5f * (c.lo + c.hi);
+    c.axes = split_axes(c);
     float bx[6][kIvLanes];
     for (int k = 0; k < 8; ++k)
         for (int a = 0; a < 3; ++a) {
-            const bool upper = (k >> a) & 1;
-            bx[2 * a][k] = upper ? mid[a] : c.lo[a];
-            bx[2 * a + 1][k] = upper ? c.hi[a] : mid[a];
+            const bool split = (c.axes >> a) & 1, upper = (k >> a) & 1;
+            bx[2 * a][k] = !split ? c.lo[a] : (upper ? mid[a] : c.lo[a]);
+            bx[2 * a + 1][k] = !split ? c.hi[a] : (upper ? c.hi[a] : mid[a]);
         }
     if (!c.tape.linked) c.tape.link();
     IntervalEvaluator& iv = s.get(c.tape.num_regs, c.tape.choices);
@@ -229,6 +245,8 @@ void TreeBuilder::split(TreeScratch& s, uint32_t i) {
         const Interval t = std::isfinite(dc[k]) ? tighten_by_centre(v, dc[k], glm::length(ch.hi - ch.lo)) : v;
         ch.ivlo = t.lo, ch.ivhi = t.hi;
         ch.depth = c.depth + 1;
+        ch.unused = (k & ~c.axes) != 0;
+        if (ch.unused) continue;  // (a copy of a used sibling's box)
         if (settled(ch.ivlo, ch.ivhi) && !(ch.depth < kTreeMaxDepth && c.tape.code.size() > kTreeLeafTape && near_surface(ch))) {
             ch.ref_cell = i;  // will not be split: runs this cell's tape
             kept = true;
@@ -262,9 +280,14 @@ void TreeBuilder::emit(TapeTree& T) {
         TreeCell& c = cells_[i];
         TapeTree::Node& node = T.nodes[i];
         for (int a = 0; a < 3; ++a) T.boxes_[i].lo[a] = c.lo[a], T.boxes_[i].hi[a] = c.hi[a];
+        if (c.unused) {  // never reached; points at leaf 0 (the full program) all the same
+            node.child = TapeTree::kLeafBit;
+            for (int a = 0; a < 3; ++a) T.boxes_[i].lo[a] = INFINITY, T.boxes_[i].hi[a] = -INFINITY;
+            continue;
+        }
         if (first_child_[i] != kNone) {
             const glm::vec3 mid = 0.5f * (c.lo + c.hi);
-            for (int a = 0; a < 3; ++a) node.c[a] = mid[a];
+            for (int a = 0; a < 3; ++a) node.c[a] = (c.axes >> a) & 1 ? mid[a] : INFINITY;
             node.child = first_child_[i];
             for (uint32_t k = 0; k < 8; ++k) T.boxes_[first_child_[i] + k].parent = static_cast<uint32_t>(i);
             if (keep_[i]) {

@@ -46,8 +46,9 @@ struct TapeTree {
         uint32_t len;
         uint16_t out;
         uint32_t node;       // its node (leaf 0: the root)
+        const Guard* guards = nullptr;  // leaf 0: the program's (the VM skips far regions)
         // The tape for an evaluator sized to the tree's max_regs.
-        TapeView view() const { return TapeView{code, len, &out, 1, 0}; }
+        TapeView view() const { return TapeView{code, len, &out, 1, 0, TapeView::kUncounted, guards}; }
     };
     glm::vec3 lo{0}, hi{0};
     std::vector<Node> nodes;
@@ -63,7 +64,7 @@ struct TapeTree {
         tapes.assign(1, p.code);
         constexpr float inf = INFINITY;
         leaves.assign(1, Leaf{{inf, inf, inf}, {-inf, -inf, -inf}, -inf, inf, tapes[0].data(), static_cast<uint32_t>(tapes[0].size()),
-                              p.outputs.empty() ? uint16_t(0) : p.outputs[0], 0});
+                              p.outputs.empty() ? uint16_t(0) : p.outputs[0], 0, p.guards.empty() ? nullptr : p.guards.data()});
         max_regs = std::max<uint32_t>(p.num_regs, 1);
         nodes.clear();
         boxes_.clear();

@@ -417,6 +417,33 @@ float* alloc_floats(size_t count) {  // uninitialised: a register is written bef
     return static_cast<float*>(p);
 }
 
+// The choice of a sign-only min/max (kSignOnly, runtime/eval/tape.hpp) over a box, given
+// the value choice c: only "result < 0" matters, so
+//   min(a, b) < 0  is  a < 0 or b < 0:   a < 0 throughout -> a;  a >= 0 throughout -> b
+//   max(a, b) < 0  is  a < 0 and b < 0:  a >= 0 throughout -> a; a < 0 throughout -> b
+// (and the same with a and b swapped). The VM's min_/max_ with a NaN operand do not follow
+// these, so both operands must be known (not NaN); an immediate decides alone.
+template <Op O>
+SDFC_IV_INLINE uint8_t sign_choice(uint8_t c, float al, float ah, float bl, float bh, float k) {
+    if constexpr (O == Op::Min || O == Op::Max) {
+        const bool known = (al == al) & (ah == ah) & (bl == bl) & (bh == bh);
+        const bool neg_a = ah < 0.0f, neg_b = bh < 0.0f, pos_a = al >= 0.0f, pos_b = bl >= 0.0f;
+        const bool pick_a = O == Op::Min ? (neg_a | pos_b) : (pos_a | neg_b);
+        const bool pick_b = O == Op::Min ? (neg_b | pos_a) : (pos_b | neg_a);
+        const uint8_t s = pick_a ? uint8_t(kChoiceA) : (pick_b ? uint8_t(kChoiceB) : uint8_t(kChoiceBoth));
+        return c != kChoiceBoth ? c : (known ? s : c);
+    } else if constexpr (O == Op::MinI) {
+        // k >= 0: min(a, k) < 0 is a < 0 (also for NaN a); k < 0: always true (not for NaN a).
+        const bool known = (al == al) & (ah == ah);
+        return c != kChoiceBoth ? c : (k >= 0.0f ? uint8_t(kChoiceA) : ((k < 0.0f) & known ? uint8_t(kChoiceB) : c));
+    } else if constexpr (O == Op::MaxI) {
+        // k < 0: max(a, k) < 0 is a < 0; k >= 0: never (both also for NaN a).
+        return c != kChoiceBoth ? c : (k < 0.0f ? uint8_t(kChoiceA) : (k >= 0.0f ? uint8_t(kChoiceB) : c));
+    } else {
+        return c;
+    }
+}
+
 }  // namespace
 
 // The kernel for each instruction set the build carries (runtime/eval/isa.hpp).

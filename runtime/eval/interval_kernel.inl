@@ -1,6 +1,31 @@
 // The interval evaluator's kernel: included by interval.cpp once per instruction set, each
 // copy in its own namespace (runtime/eval/isa.hpp); no include guard on purpose.
 
+// One choice op over m lanes; SignOnly: also decided by sign (sign_choice in interval.cpp).
+// Operands are read before the output is written: it may share their register.
+template <Op O, bool SignOnly>
+SDFC_IV_INLINE void choice_op(const Instr& in, float* const L, float* const H, uint8_t* chp, int m) {
+    float* rl = L + size_t(in.out) * kIvLanes;
+    float* rh = H + size_t(in.out) * kIvLanes;
+    const float* al = L + size_t(in.a) * kIvLanes;
+    const float* ah = H + size_t(in.a) * kIvLanes;
+    const float* bl = L + size_t(in.b) * kIvLanes;
+    const float* bh = H + size_t(in.b) * kIvLanes;
+    const float* cl = L + size_t(in.c) * kIvLanes;
+    const float* chh = H + size_t(in.c) * kIvLanes;
+    const float k = in.k;
+    SDFC_IVDEP
+    for (int i = 0; i < m; ++i) {
+        uint8_t c;
+        float lo, hi;
+        iv<O>(al[i], ah[i], bl[i], bh[i], cl[i], chh[i], k, lo, hi, c);
+        if constexpr (SignOnly) c = sign_choice<O>(c, al[i], ah[i], bl[i], bh[i], k);
+        rl[i] = lo;
+        rh[i] = hi;
+        chp[i] = c;
+    }
+}
+
 void run(const TapeView& t, float* const L, float* const H, uint8_t* chp, const float* xlo, const float* xhi, const float* ylo,
          const float* yhi, const float* zlo, const float* zhi, int n, int m, float time) {
     auto input = [&](const Instr& in, const float* l, const float* h) {
@@ -33,15 +58,10 @@ void run(const TapeView& t, float* const L, float* const H, uint8_t* chp, const 
             std::fill_n(rh, m, time);                                                       \
         } else {                                                                            \
             if constexpr (is_choice_op(Op::name)) {                                         \
-                SDFC_IVDEP                                                                  \
-                for (int i = 0; i < m; ++i) {                                               \
-                    uint8_t c;                                                              \
-                    float lo, hi;                                                           \
-                    iv<Op::name>(al[i], ah[i], bl[i], bh[i], cl[i], chh[i], k, lo, hi, c);  \
-                    rl[i] = lo;                                                             \
-                    rh[i] = hi;                                                             \
-                    chp[i] = c;                                                             \
-                }                                                                           \
+                if (in.pad & kSignOnly)                                                     \
+                    choice_op<Op::name, true>(in, L, H, chp, m);                            \
+                else                                                                        \
+                    choice_op<Op::name, false>(in, L, H, chp, m);                           \
                 chp += m;                                                                   \
             } else {                                                                        \
                 SDFC_IVDEP                                                                  \

@@ -62,6 +62,24 @@ void Tape::link() {
     }
 }
 
+void Tape::mark_sign_only() {
+    if (!linked || out_def == kNone) return;
+    const size_t n = code.size();
+    // Per instruction: 1 used only through sign-only min/max ops (or as the output), 3 its
+    // value is needed. Users come after their operands, so a backward walk sees all of an
+    // instruction's users before it.
+    std::vector<uint8_t> use(n, 0);
+    use[out_def] = 1;
+    for (size_t i = n; i-- > 0;) {
+        Instr& in = code[i];
+        const bool minmax = in.op == Op::Min || in.op == Op::Max || in.op == Op::MinI || in.op == Op::MaxI;
+        const bool sign = use[i] == 1 && minmax;
+        in.pad = uint8_t(sign ? (in.pad | kSignOnly) : (in.pad & ~kSignOnly));
+        if (!use[i]) continue;
+        for (int j = 0; j < kOpInfo[int(in.op)].arity; ++j) use[links[i].def[j]] |= sign ? 1 : 3;
+    }
+}
+
 void Tape::assign(const Instr* c, size_t count, uint16_t out_reg, uint32_t regs) {
     code.assign(c, c + count);
     out = out_reg;

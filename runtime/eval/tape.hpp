@@ -27,6 +27,13 @@ inline constexpr uint64_t kChoiceOps = 0
 static_assert(kOpCount <= 64);
 constexpr bool is_choice_op(Op op) { return (kChoiceOps >> int(op)) & 1; }
 
+// Instr::pad bit: only whether this min/max's result is < 0 matters to the tape's output,
+// which is itself only tested for < 0 (a 2D image's inside). The interval evaluator may
+// then also decide the op by sign alone: min(a, b) with a >= 0 over the whole box is b as
+// far as "< 0" goes, even where a and b overlap. Simplified tapes keep the bit (it stays
+// true: a winner inherits only the sign-only uses of the op it replaces).
+inline constexpr uint8_t kSignOnly = 1;
+
 // A straight-line program with one output: a Program's output, or a shortened copy.
 // link() adds what simplify() needs to visit only the live part of a tape: for every
 // operand the index of the instruction that defined its value (registers are reused, so
@@ -52,6 +59,9 @@ struct Tape {
     void assign(const Instr* code, size_t count, uint16_t out_reg, uint32_t regs);  // a child of simplify_batch
     void recount();  // sets num_regs and choices from code
     void link();     // fills links and out_def
+    // Sets kSignOnly on the min/max ops whose every use is a sign-only min/max or the
+    // output (linked tapes only): for tapes whose output is only tested for < 0.
+    void mark_sign_only();
 
     // (choices is only sure once linked: assign() leaves it stale)
     TapeView view() const {

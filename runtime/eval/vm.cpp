@@ -1,6 +1,7 @@
 #include "runtime/eval/vm.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <iterator>
@@ -57,7 +58,8 @@ SDFC_ISA_END
 #endif
 
 namespace {
-using RunFn = void (*)(const Instr*, const Instr*, float*, const float*, const float*, const float*, int, int, float);
+using RunFn = void (*)(const Instr*, const Instr*, const Guard*, float*, const float*, const float*, const float*, int, int,
+                      float);
 struct Kernels {
     RunFn full, part;
 };
@@ -80,8 +82,8 @@ void BatchVM::eval(const TapeView& t, const float* x, const float* y, const floa
     const int m = (n + kGroup - 1) / kGroup * kGroup;  // lanes computed
     const Instr* end = t.code + t.len;
     const Kernels& k = kernels();
-    if (m == kBatch) k.full(t.code, end, regs_, x, y, z, n, m, time);
-    else k.part(t.code, end, regs_, x, y, z, n, m, time);
+    if (m == kBatch) k.full(t.code, end, t.guards, regs_, x, y, z, n, m, time);
+    else k.part(t.code, end, t.guards, regs_, x, y, z, n, m, time);
 }
 
 void sample_batch(const Program& p, const float* x, const float* y, const float* z, size_t n, float time, float* out) {

@@ -5,8 +5,35 @@
 // loops unroll completely) or given at run time (m, a multiple of kGroup) otherwise.
 // Dispatch is a computed goto with one indirect jump per handler (GCC/clang), which the
 // branch predictor learns per opcode, or a switch elsewhere.
+// Whether every one of the n points is far enough outside guard g's box to skip its region
+// (program.hpp Guard): farther than the threshold `thr` by a margin that covers the region's
+// rounding errors (its distance is never below the box's in exact arithmetic), so that
+// skipping changes no float of the union: the batch VM stays bit for bit the scalar
+// reference, which runs through.
+SDFC_IV_INLINE bool guard_skips_lane(const Guard& g, float box, float x, float y, float z, float thr) {
+    const float ex = std::max(std::max(g.lo[0] - x, x - g.hi[0]), 0.0f);
+    const float ey = std::max(std::max(g.lo[1] - y, y - g.hi[1]), 0.0f);
+    const float ez = std::max(std::max(g.lo[2] - z, z - g.hi[2]), 0.0f);
+    const float e2 = ex * ex + ey * ey + ez * ez;
+    const float need = thr + 0x1p-14f * (1.0f + box + std::fabs(x) + std::fabs(y) + std::fabs(z) + std::fabs(thr));
+    return need > 0.0f && e2 >= need * need;  // NaN or +inf: never skips
+}
+inline bool guard_skips_all(const Guard& g, const float* base, const float* thr, int n) {
+    const float* px = base + static_cast<size_t>(g.px) * kBatch;
+    const float* py = base + static_cast<size_t>(g.py) * kBatch;
+    const float* pz = base + static_cast<size_t>(g.pz) * kBatch;
+    const float box = std::max(std::max(std::max(std::fabs(g.lo[0]), std::fabs(g.hi[0])), std::max(std::fabs(g.lo[1]), std::fabs(g.hi[1]))),
+                               std::max(std::fabs(g.lo[2]), std::fabs(g.hi[2])));
+    // Most regions that run fail at the first point; the rest check every point at once.
+    if (!guard_skips_lane(g, box, px[0], py[0], pz[0], thr[0])) return false;
+    int fail = 0;
+    SDFC_IVDEP
+    for (int i = 1; i < n; ++i) fail |= int(!guard_skips_lane(g, box, px[i], py[i], pz[i], thr[i]));
+    return fail == 0;
+}
+
 template <bool FULL>
-inline void run(const Instr* code, const Instr* end, float* base, const float* x, const float* y,
+inline void run(const Instr* code, const Instr* end, const Guard* guards, float* base, const float* x, const float* y,
                        const float* z, int n, int m_rt, float time) {
     const int m = FULL ? kBatch : m_rt;
     auto load = [&](float* R, const float* src) {
@@ -45,7 +72,13 @@ inline void run(const Instr* code, const Instr* end, float* base, const float* x
         else if constexpr (Op::name == Op::VarY) load(R, y);                       \
         else if constexpr (Op::name == Op::VarZ) load(R, z);                       \
         else if constexpr (Op::name == Op::Time) std::fill_n(R, m, time);          \
-        else {                                                                     \
+        else if constexpr (Op::name == Op::Guard) {                                \
+            /* (its out may share the threshold's or the point's register) */      \
+            const Guard* g = guards ? &guards[guard_index(*ip)] : nullptr;         \
+            const bool skip = g && guard_skips_all(*g, base, A, n);                \
+            std::fill_n(R, m, om::kSkipped);                                       \
+            if (skip) ip = code + g->end - 1;                                      \
+        } else {                                                                   \
             SDFC_IVDEP                                                             \
             for (int i = 0; i < m; ++i) {                                          \
                 [[maybe_unused]] const float a = A[i];                             \
@@ -65,11 +98,11 @@ inline void run(const Instr* code, const Instr* end, float* base, const float* x
 #undef SDFC_CASE
 }
 
-void run_full(const Instr* code, const Instr* end, float* base, const float* x, const float* y, const float* z, int n,
-              int m, float time) {
-    run<true>(code, end, base, x, y, z, n, m, time);
+void run_full(const Instr* code, const Instr* end, const Guard* guards, float* base, const float* x, const float* y,
+              const float* z, int n, int m, float time) {
+    run<true>(code, end, guards, base, x, y, z, n, m, time);
 }
-void run_part(const Instr* code, const Instr* end, float* base, const float* x, const float* y, const float* z, int n,
-              int m, float time) {
-    run<false>(code, end, base, x, y, z, n, m, time);
+void run_part(const Instr* code, const Instr* end, const Guard* guards, float* base, const float* x, const float* y,
+              const float* z, int n, int m, float time) {
+    run<false>(code, end, guards, base, x, y, z, n, m, time);
 }

@@ -35,7 +35,8 @@ std::vector<float> BatchVm::eval(const Program& p, const std::vector<Point>& pts
 template <Simplifier S>
 std::vector<std::vector<float>> SimplifiedTape<S>::eval_in_boxes(const Program& p, const std::vector<Box>& boxes,
                                                                  const std::vector<std::vector<Point>>& pts, float time) {
-    const Tape full = Tape::from(p);
+    Tape full = Tape::from(p);
+    if (S == Simplifier::SignOnly) full.mark_sign_only();
     IntervalEvaluator iv(full.num_regs, full.choices);
     Evaluator ev(p);
     SimplifyScratch one;
@@ -52,7 +53,7 @@ std::vector<std::vector<float>> SimplifiedTape<S>::eval_in_boxes(const Program& 
         iv.eval(full, lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], n, time);
         if (S != Simplifier::One)
             simplify_batch(full, iv.choices(), iv.stride(), n == 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1, batch,
-                           S == Simplifier::BatchCompact);
+                           S != Simplifier::BatchTrace);
         for (int l = 0; l < n; ++l) {
             const Instr* code;
             size_t len;
@@ -104,6 +105,7 @@ std::vector<float> SimplifiedTape<S>::eval(const Program& p, const std::vector<P
 template struct SimplifiedTape<Simplifier::One>;
 template struct SimplifiedTape<Simplifier::BatchCompact>;
 template struct SimplifiedTape<Simplifier::BatchTrace>;
+template struct SimplifiedTape<Simplifier::SignOnly>;
 
 // --- intervals ---
 

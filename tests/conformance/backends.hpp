@@ -42,7 +42,9 @@ struct BatchVm {
 
 // Tapes simplified for a box (runtime/eval/interval.hpp), run by the VM: bit for bit the
 // full program's floats at every point of the box. Three ways to simplify:
-enum class Simplifier { One, BatchCompact, BatchTrace };  // simplify(), simplify_batch(compact), (trace)
+// SignOnly: simplify_batch(compact) of a tape marked for its sign alone (Tape::mark_sign_only,
+// as the 2D renderer does): not the same floats, only the same "< 0" at every point.
+enum class Simplifier { One, BatchCompact, BatchTrace, SignOnly };  // simplify(), simplify_batch(compact), (trace)
 template <Simplifier S>
 struct SimplifiedTape {
     static constexpr bool kVmFloats = true;
@@ -56,6 +58,7 @@ struct SimplifiedTape {
 using SimplifyOne = SimplifiedTape<Simplifier::One>;
 using SimplifyBatchCompact = SimplifiedTape<Simplifier::BatchCompact>;
 using SimplifyBatchTrace = SimplifiedTape<Simplifier::BatchTrace>;
+using SimplifySignOnly = SimplifiedTape<Simplifier::SignOnly>;
 
 // The GLSL emitter (compiler/glsl/glsl_emit.hpp) on Mesa llvmpipe: each case is a fragment
 // shader that reads the points from a float texture and writes the value's bits as RGBA8.

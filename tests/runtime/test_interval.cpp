@@ -149,3 +149,52 @@ TEST_CASE("simplify_batch: compact tapes and traces compute the full tape's floa
     }
     REQUIRE(shorter > 0);
 }
+
+TEST_CASE("sign-only min/max (a 2D image's tape) are decided by sign where the operands' intervals overlap") {
+    // One op over x and y in a box: the choice the interval evaluator records, with and
+    // without Tape::mark_sign_only.
+    auto choice = [](Op op, float k, Interval x, Interval y, bool sign_only) {
+        Tape t = Tape::from(test::single_op_program(op, k));
+        if (sign_only) t.mark_sign_only();
+        IntervalEvaluator iv(t.num_regs, t.choices);
+        const float z = 0.0f;
+        iv.eval(t, &x.lo, &x.hi, &y.lo, &y.hi, &z, &z, 1);
+        return iv.choices()[0];
+    };
+    const float nan = std::nanf("");
+    const Interval pos{0.5f, 2.0f}, neg{-2.0f, -0.5f}, across{-1.0f, 1.0f}, unknown{nan, nan};
+    // Overlapping values: the value rule keeps both sides.
+    CHECK(choice(Op::Min, 0, pos, across, false) == kChoiceBoth);
+    CHECK(choice(Op::Max, 0, neg, across, false) == kChoiceBoth);
+    // min(a, b) < 0 is b < 0 where a >= 0; max(a, b) < 0 is b < 0 where a < 0.
+    CHECK(choice(Op::Min, 0, pos, across, true) == kChoiceB);
+    CHECK(choice(Op::Min, 0, across, pos, true) == kChoiceA);
+    CHECK(choice(Op::Max, 0, neg, across, true) == kChoiceB);
+    CHECK(choice(Op::Max, 0, across, neg, true) == kChoiceA);
+    // A side of one sign that settles the result: min with a negative side, max with a
+    // positive one (value rule undecided: [-1, 1] against [-2, -0.5] overlap).
+    CHECK(choice(Op::Min, 0, neg, across, true) == kChoiceA);
+    CHECK(choice(Op::Max, 0, across, pos, true) == kChoiceB);
+    // Straddling both: undecided; an unknown side (NaN may occur): undecided.
+    CHECK(choice(Op::Min, 0, across, across, true) == kChoiceBoth);
+    CHECK(choice(Op::Min, 0, pos, unknown, true) == kChoiceBoth);
+    CHECK(choice(Op::Max, 0, unknown, neg, true) == kChoiceBoth);
+    // Immediates: min(a, 0.5) < 0 is a < 0; max(a, -0.5) < 0 is a < 0; max(a, 0.5) never.
+    CHECK(choice(Op::MinI, 0.5f, across, across, true) == kChoiceA);
+    CHECK(choice(Op::MaxI, -0.5f, across, across, true) == kChoiceA);
+    CHECK(choice(Op::MaxI, 0.5f, across, across, true) == kChoiceB);
+    CHECK(choice(Op::MinI, -0.5f, across, across, true) == kChoiceB);
+    CHECK(choice(Op::MinI, -0.5f, unknown, across, true) == kChoiceBoth);
+    // A min whose value another op needs is not sign-only: min(x, y) * 2 ...
+    Program p = test::single_op_program(Op::Min, 0);
+    Instr twice{Op::MulI};
+    twice.out = 3, twice.a = 3, twice.k = 2.0f;
+    p.code.push_back(twice);
+    Tape t = Tape::from(p);
+    t.mark_sign_only();
+    CHECK(!(t.code[3].pad & kSignOnly));
+    // ... while a chain of min/max up to the output is.
+    Tape u = Tape::from(test::single_op_program(Op::Min, 0));
+    u.mark_sign_only();
+    CHECK((u.code[3].pad & kSignOnly));
+}

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "runtime/eval/interval.hpp"
+#include "runtime/eval/vm.hpp"
 #include "support.hpp"
 
 using namespace sdfc;
@@ -72,4 +73,47 @@ TEST_CASE("spatial union: a small box keeps a few spheres of a 100 x 100 grid", 
     const size_t chain_len = tape_in_box(chain->cs, 0.08f, 0.06f, 0.08f, 0.5f);
     INFO("chain " << chain_len);
     CHECK(chain_len > 4 * len);
+}
+
+TEST_CASE("spatial union: the batch VM skips a guarded region only when every point of the batch is far from its box",
+          "[union][guard]") {
+    // A region that lies (its value 0.5 is below its box's distance) shows whether it ran:
+    // min(1, region) is 0.5 when it ran, 1 when it was skipped.
+    Program p;
+    auto add = [&](Op op, uint16_t out, uint16_t a = 0, uint16_t b = 0, float k = 0.0f) {
+        Instr in{op};
+        in.out = out, in.a = a, in.b = b, in.k = k;
+        p.code.push_back(in);
+    };
+    add(Op::VarX, 0), add(Op::VarY, 1), add(Op::VarZ, 2);
+    add(Op::Const, 3, 0, 0, 1.0f);  // the union's distance so far: the threshold
+    add(Op::Guard, 4, 3, 0, 0.0f);  // guards[0]
+    add(Op::Const, 4, 0, 0, 0.5f);  // the region
+    add(Op::Min, 5, 3, 4);
+    Guard g;
+    g.px = 0, g.py = 1, g.pz = 2;
+    g.lo[0] = g.lo[1] = g.lo[2] = 10.0f;
+    g.hi[0] = g.hi[1] = g.hi[2] = 11.0f;
+    g.end = 6;
+    p.guards.push_back(g);
+    p.locs.resize(p.code.size());
+    p.num_regs = 6;
+    p.outputs = {5};
+    p.output_names = {"out"};
+    Evaluator ev(p);
+    float xs[kBatch], ys[kBatch], zs[kBatch];
+    for (int i = 0; i < kBatch; ++i) xs[i] = ys[i] = zs[i] = 0.01f * float(i);  // 15.6 .. 17.3 from the box
+    ev.eval(xs, ys, zs, kBatch);
+    for (int i = 0; i < kBatch; ++i) CHECK(ev.output(0)[i] == 1.0f);  // skipped
+    xs[40] = 9.5f, ys[40] = 10.5f, zs[40] = 10.5f;  // one point 0.5 from the box: within 1
+    ev.eval(xs, ys, zs, kBatch);
+    for (int i = 0; i < kBatch; ++i) CHECK(ev.output(0)[i] == 0.5f);  // ran, for all
+    xs[40] = 8.95f;  // 1.05 from the box: beyond the threshold and its rounding margin (~0.003)
+    ev.eval(xs, ys, zs, kBatch);
+    for (int i = 0; i < kBatch; ++i) CHECK(ev.output(0)[i] == 1.0f);
+    // Tapes without the guard table (shortened tapes) always run through.
+    TapeView v = p.view();
+    v.guards = nullptr;
+    ev.eval(v, xs, ys, zs, kBatch);
+    for (int i = 0; i < kBatch; ++i) CHECK(ev.output(v)[i] == 0.5f);
 }
