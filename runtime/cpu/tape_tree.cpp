@@ -96,6 +96,7 @@ struct TreeScratch {
             regs = std::max(regs, r);
             choices = std::max(choices, c);
             iv = std::make_unique<IntervalEvaluator>(regs, choices);
+            iv->keep_chains(true);
         }
         return *iv;
     }
@@ -114,6 +115,7 @@ public:
           budget_(kTreeWorkBase + kTreeWorkPerInstr * p.code.size() + kTreeWorkPerSample * samples) {
         cells_[0].lo = lo, cells_[0].hi = hi;
         cells_[0].tape = Tape::from(p, 0);
+        cells_[0].tape.mark_min_chains();  // a union's far shapes go against its nearest anywhere
         consider(0);
     }
 
@@ -216,6 +218,7 @@ void TreeBuilder::split(TreeScratch& s, uint32_t i) {
     if (!c.tape.linked) c.tape.link();
     IntervalEvaluator& iv = s.get(c.tape.num_regs, c.tape.choices);
     iv.eval(c.tape, bx[0], bx[1], bx[2], bx[3], bx[4], bx[5], 8, time_);
+    iv.prune_min_chains(c.tape, 8);
     s.boxes += 8;
     // Children the intervals leave ambiguous: tighten with the centre values (one
     // evaluation of this cell's tape at the 8 centres).

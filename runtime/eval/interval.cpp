@@ -464,8 +464,8 @@ SDFC_ISA_END
 #endif
 
 namespace {
-using RunFn = void (*)(const TapeView&, float*, float*, uint8_t*, const float*, const float*, const float*, const float*,
-                       const float*, const float*, int, int, float);
+using RunFn = void (*)(const TapeView&, float*, float*, uint8_t*, float*, const float*, const float*, const float*,
+                       const float*, const float*, const float*, int, int, float);
 const RunFn kKernels[] = {
     iv_baseline::run,
 #if defined(SDFC_ISA_DISPATCH)
@@ -526,7 +526,57 @@ void IntervalEvaluator::eval(const TapeView& t, const float* xlo, const float* x
     const int m = (n + 7) / 8 * 8;  // lanes computed (whole vectors); padding copies lane n-1
     stride_ = m;
     out_ = t.output(0);
-    kernels()(t, lo_, hi_, choices_.get(), xlo, xhi, ylo, yhi, zlo, zhi, n, m, time);
+    float* cv = nullptr;
+    if (keep_chains_) {
+        if (chain_.size() < size_t(nch) * 4 * size_t(m)) chain_.resize(size_t(nch) * 4 * size_t(m));
+        cv = chain_.data();
+    }
+    kernels()(t, lo_, hi_, choices_.get(), cv, xlo, xhi, ylo, yhi, zlo, zhi, n, m, time);
+}
+
+// Top-down over the chain: bound[i] is an upper bound, over the box, of the rest of the
+// chain around Min i (what the output would be without i's value); an operand whose lower
+// bound exceeds min(bound, its sibling's upper bound) can never be the output. Dropping
+// several at once keeps the output's floats: the operand with the least upper bound of all
+// is never dropped and is below every dropped one at every point, and min() selects.
+// Unknown (NaN) intervals anywhere in a lane's chain leave that lane alone (the VM's min
+// with a NaN operand depends on the order).
+void IntervalEvaluator::prune_min_chains(const Tape& t, int n) {
+    if (!keep_chains_ || !t.linked || t.out_def == Tape::kNone) return;
+    const size_t len = t.code.size(), m = size_t(stride_);
+    if (!(t.code[t.out_def].pad & kMinChain) || t.code[t.out_def].op != Op::Min) return;
+    uint64_t bad = 0;  // lanes with an unknown interval in the chain
+    for (size_t i = 0; i < len; ++i) {
+        if (!(t.code[i].pad & kMinChain) || t.code[i].op != Op::Min) continue;
+        const float* cv = chain_.data() + size_t(t.links[i].slot) * 4 * m;
+        for (int j = 0; j < n; ++j)
+            if (std::isnan(cv[j]) || std::isnan(cv[m + j]) || std::isnan(cv[2 * m + j]) || std::isnan(cv[3 * m + j]))
+                bad |= uint64_t(1) << j;
+    }
+    if (bad == (n == 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1)) return;
+    bound_.assign(len * m, kInf);
+    uint8_t* choices = choices_.get();
+    auto chain_min = [&](uint32_t d) { return d != Tape::kNone && t.code[d].op == Op::Min && (t.code[d].pad & kMinChain); };
+    for (size_t i = len; i-- > 0;) {
+        if (!(t.code[i].pad & kMinChain) || t.code[i].op != Op::Min) continue;
+        const Tape::Link& l = t.links[i];
+        const float* cv = chain_.data() + size_t(l.slot) * 4 * m;
+        uint8_t* ch = choices + size_t(l.slot) * m;
+        const float* B = bound_.data() + i * m;
+        float* Ba = chain_min(l.def[0]) ? bound_.data() + size_t(l.def[0]) * m : nullptr;
+        float* Bb = chain_min(l.def[1]) ? bound_.data() + size_t(l.def[1]) * m : nullptr;
+        for (int j = 0; j < n; ++j) {
+            if ((bad >> j) & 1) continue;
+            const float al = cv[j], ah = cv[m + j], bl = cv[2 * m + j], bh = cv[3 * m + j];
+            const float for_a = mn(bh, B[j]), for_b = mn(ah, B[j]);  // bounds of the rest, seen from a and from b
+            if (ch[j] == kChoiceBoth) {
+                if (al > for_a) ch[j] = kChoiceB;
+                else if (bl > for_b) ch[j] = kChoiceA;
+            }
+            if (Ba && ch[j] != kChoiceB) Ba[j] = mn(Ba[j], for_a);
+            if (Bb && ch[j] != kChoiceA) Bb[j] = mn(Bb[j], for_b);
+        }
+    }
 }
 
 }  // namespace sdfc

@@ -53,6 +53,12 @@ public:
         eval(t.view(), xlo, xhi, ylo, yhi, zlo, zhi, n, time);
     }
     void reserve(uint32_t regs, uint32_t choices);
+    // With keep_chains (for tapes marked by Tape::mark_min_chains), eval also keeps the
+    // operand intervals of chain mins, and prune_min_chains(t, n) then decides more of their
+    // choices, for the output of the whole chain: the tape simplified with them computes
+    // the same floats at the output as t in each box (not at the chain's inner mins).
+    void keep_chains(bool on) { keep_chains_ = on; }
+    void prune_min_chains(const Tape& t, int n);
 
     Interval result(int lane) const { return {lo_[out_ * kIvLanes + lane], hi_[out_ * kIvLanes + lane]}; }
     // Choice of slot s for lane i: choices()[s * stride() + i] (stride: n rounded up to 8;
@@ -67,6 +73,9 @@ private:
     std::unique_ptr<uint8_t[]> choices_;
     int stride_ = 0;
     uint16_t out_ = 0;
+    bool keep_chains_ = false;
+    std::vector<float> chain_;  // per choice slot: al, ah, bl, bh rows of stride_ lanes
+    std::vector<float> bound_;  // prune_min_chains: per instruction and lane
 };
 
 }  // namespace sdfc

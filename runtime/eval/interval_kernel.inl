@@ -3,8 +3,10 @@
 
 // One choice op over m lanes; SignOnly: also decided by sign (sign_choice in interval.cpp).
 // Operands are read before the output is written: it may share their register.
-template <Op O, bool SignOnly>
-SDFC_IV_INLINE void choice_op(const Instr& in, float* const L, float* const H, uint8_t* chp, int m) {
+// Chain: also keeps the operands' intervals (al, ah, bl, bh: 4 rows of m) for
+// prune_min_chains.
+template <Op O, bool SignOnly, bool Chain>
+SDFC_IV_INLINE void choice_op(const Instr& in, float* const L, float* const H, uint8_t* chp, float* cv, int m) {
     float* rl = L + size_t(in.out) * kIvLanes;
     float* rh = H + size_t(in.out) * kIvLanes;
     const float* al = L + size_t(in.a) * kIvLanes;
@@ -20,13 +22,19 @@ SDFC_IV_INLINE void choice_op(const Instr& in, float* const L, float* const H, u
         float lo, hi;
         iv<O>(al[i], ah[i], bl[i], bh[i], cl[i], chh[i], k, lo, hi, c);
         if constexpr (SignOnly) c = sign_choice<O>(c, al[i], ah[i], bl[i], bh[i], k);
+        if constexpr (Chain) {
+            cv[i] = al[i];
+            cv[m + i] = ah[i];
+            cv[2 * m + i] = bl[i];
+            cv[3 * m + i] = bh[i];
+        }
         rl[i] = lo;
         rh[i] = hi;
         chp[i] = c;
     }
 }
 
-void run(const TapeView& t, float* const L, float* const H, uint8_t* chp, const float* xlo, const float* xhi, const float* ylo,
+void run(const TapeView& t, float* const L, float* const H, uint8_t* chp, float* cv, const float* xlo, const float* xhi, const float* ylo,
          const float* yhi, const float* zlo, const float* zhi, int n, int m, float time) {
     auto input = [&](const Instr& in, const float* l, const float* h) {
         float* rl = L + size_t(in.out) * kIvLanes;
@@ -58,11 +66,14 @@ void run(const TapeView& t, float* const L, float* const H, uint8_t* chp, const 
             std::fill_n(rh, m, time);                                                       \
         } else {                                                                            \
             if constexpr (is_choice_op(Op::name)) {                                         \
-                if (in.pad & kSignOnly)                                                     \
-                    choice_op<Op::name, true>(in, L, H, chp, m);                            \
+                if (Op::name == Op::Min && cv && (in.pad & kMinChain))                      \
+                    choice_op<Op::name, false, true>(in, L, H, chp, cv, m);                 \
+                else if (in.pad & kSignOnly)                                                \
+                    choice_op<Op::name, true, false>(in, L, H, chp, cv, m);                 \
                 else                                                                        \
-                    choice_op<Op::name, false>(in, L, H, chp, m);                           \
+                    choice_op<Op::name, false, false>(in, L, H, chp, cv, m);                \
                 chp += m;                                                                   \
+                if (cv) cv += 4 * m;                                                        \
             } else {                                                                        \
                 SDFC_IVDEP                                                                  \
                 for (int i = 0; i < m; ++i) {                                               \

@@ -62,22 +62,36 @@ void Tape::link() {
     }
 }
 
-void Tape::mark_sign_only() {
-    if (!linked || out_def == kNone) return;
-    const size_t n = code.size();
-    // Per instruction: 1 used only through sign-only min/max ops (or as the output), 3 its
-    // value is needed. Users come after their operands, so a backward walk sees all of an
-    // instruction's users before it.
-    std::vector<uint8_t> use(n, 0);
-    use[out_def] = 1;
+namespace {
+
+// Sets `bit` on the ops `passes` accepts whose every use is such an op (with the bit) or the
+// output; ops `ignored` accepts do not count as uses. Users come after their operands, so a
+// backward walk sees all of an instruction's users before it.
+template <class Passes, class Ignored>
+void mark_chains(Tape& t, uint8_t bit, Passes passes, Ignored ignored) {
+    if (!t.linked || t.out_def == Tape::kNone) return;
+    const size_t n = t.code.size();
+    std::vector<uint8_t> use(n, 0);  // 1: used only through marked ops (or as the output), 3: its value is needed
+    use[t.out_def] = 1;
     for (size_t i = n; i-- > 0;) {
-        Instr& in = code[i];
-        const bool minmax = in.op == Op::Min || in.op == Op::Max || in.op == Op::MinI || in.op == Op::MaxI;
-        const bool sign = use[i] == 1 && minmax;
-        in.pad = uint8_t(sign ? (in.pad | kSignOnly) : (in.pad & ~kSignOnly));
-        if (!use[i]) continue;
-        for (int j = 0; j < kOpInfo[int(in.op)].arity; ++j) use[links[i].def[j]] |= sign ? 1 : 3;
+        Instr& in = t.code[i];
+        const bool marked = (use[i] & 2) == 0 && passes(in.op);
+        in.pad = uint8_t(marked ? (in.pad | bit) : (in.pad & ~bit));
+        if (ignored(in.op)) continue;
+        for (int j = 0; j < kOpInfo[int(in.op)].arity; ++j) use[t.links[i].def[j]] |= marked ? 1 : 3;
     }
+}
+
+}  // namespace
+
+void Tape::mark_sign_only() {
+    mark_chains(
+        *this, kSignOnly, [](Op op) { return op == Op::Min || op == Op::Max || op == Op::MinI || op == Op::MaxI; },
+        [](Op) { return false; });
+}
+
+void Tape::mark_min_chains() {
+    mark_chains(*this, kMinChain, [](Op op) { return op == Op::Min; }, [](Op op) { return op == Op::Guard; });
 }
 
 void Tape::assign(const Instr* c, size_t count, uint16_t out_reg, uint32_t regs) {

@@ -33,6 +33,12 @@ constexpr bool is_choice_op(Op op) { return (kChoiceOps >> int(op)) & 1; }
 // far as "< 0" goes, even where a and b overlap. Simplified tapes keep the bit (it stays
 // true: a winner inherits only the sign-only uses of the op it replaces).
 inline constexpr uint8_t kSignOnly = 1;
+// Instr::pad bit: a Min in a chain of mins up to the output (every use is such a Min, the
+// output, or a guard's threshold, which only decides skipping). Over a box, an operand
+// whose lower bound exceeds an upper bound of the rest of the chain can never be the
+// result: IntervalEvaluator::prune_min_chains drops it even where its sibling's interval
+// overlaps it (a union's far shapes, against the nearest shape anywhere in the union).
+inline constexpr uint8_t kMinChain = 2;
 
 // A straight-line program with one output: a Program's output, or a shortened copy.
 // link() adds what simplify() needs to visit only the live part of a tape: for every
@@ -62,6 +68,8 @@ struct Tape {
     // Sets kSignOnly on the min/max ops whose every use is a sign-only min/max or the
     // output (linked tapes only): for tapes whose output is only tested for < 0.
     void mark_sign_only();
+    // Sets kMinChain (linked tapes only); see above.
+    void mark_min_chains();
 
     // (choices is only sure once linked: assign() leaves it stale)
     TapeView view() const {

@@ -31,6 +31,7 @@ std::vector<Sampled> classify(const Grid& g, const Program& p, tbb::enumerable_t
     std::vector<Region> frontier(1);
     frontier[0].level = levels;
     frontier[0].tape = Tape::from(p, 0);
+    frontier[0].tape.mark_min_chains();  // a union's far shapes go against its nearest anywhere
     frontier[0].tape.link();
     std::vector<Sampled> out;
     if (levels == 0) {
@@ -59,6 +60,7 @@ std::vector<Sampled> classify(const Grid& g, const Program& p, tbb::enumerable_t
             }
             IntervalEvaluator& iv = s.interval(r.tape.num_regs, r.tape.choices);
             iv.eval(r.tape, bx[0], bx[1], bx[2], bx[3], bx[4], bx[5], n, g.time);
+            iv.prune_min_chains(r.tape, n);
             float centre[8];
             std::fill_n(centre, 8, NAN);
             if (g.lipschitz) {
@@ -107,6 +109,7 @@ Tape brick_tape(const Grid& g, const Tape& full, glm::ivec3 at, Scratch& s) {
     for (int a = 0; a < 3; ++a) bx[2 * a][0] = g.coord(a, at[a] * kB), bx[2 * a + 1][0] = g.coord(a, (at[a] + 1) * kB);
     IntervalEvaluator& iv = s.interval(full.num_regs, full.choices);
     iv.eval(full, bx[0], bx[1], bx[2], bx[3], bx[4], bx[5], 1, g.time);
+    iv.prune_min_chains(full, 1);
     simplify_batch(full, iv.choices(), iv.stride(), 1, s.bs, true);
     Tape t;
     t.assign(s.bs.code(0), s.bs.len[0], s.bs.out[0], s.bs.regs[0]);

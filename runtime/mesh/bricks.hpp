@@ -72,6 +72,7 @@ struct Scratch {
         if (!iv || regs > iv_regs || choices > iv_choices) {
             iv_regs = std::max(iv_regs, regs), iv_choices = std::max(iv_choices, choices);
             iv = std::make_unique<IntervalEvaluator>(iv_regs, iv_choices);
+            iv->keep_chains(true);  // (for tapes marked by mark_min_chains)
         }
         return *iv;
     }

@@ -261,6 +261,7 @@ Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* sta
     const Tape full = [&] {
         Tape t = Tape::from(scene.distance, 0);
         t.link();
+        t.mark_min_chains();
         return t;
     }();
     std::vector<uint8_t> want(nbricks, 0);

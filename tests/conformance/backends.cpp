@@ -37,7 +37,9 @@ std::vector<std::vector<float>> SimplifiedTape<S>::eval_in_boxes(const Program& 
                                                                  const std::vector<std::vector<Point>>& pts, float time) {
     Tape full = Tape::from(p);
     if (S == Simplifier::SignOnly) full.mark_sign_only();
+    if (S == Simplifier::MinChain) full.mark_min_chains();
     IntervalEvaluator iv(full.num_regs, full.choices);
+    iv.keep_chains(S == Simplifier::MinChain);
     Evaluator ev(p);
     SimplifyScratch one;
     BatchScratch batch;
@@ -51,6 +53,7 @@ std::vector<std::vector<float>> SimplifiedTape<S>::eval_in_boxes(const Program& 
             lo[0][l] = b.x.lo, hi[0][l] = b.x.hi, lo[1][l] = b.y.lo, hi[1][l] = b.y.hi, lo[2][l] = b.z.lo, hi[2][l] = b.z.hi;
         }
         iv.eval(full, lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], n, time);
+        iv.prune_min_chains(full, n);  // (only with keep_chains)
         if (S != Simplifier::One)
             simplify_batch(full, iv.choices(), iv.stride(), n == 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1, batch,
                            S != Simplifier::BatchTrace);
@@ -106,6 +109,7 @@ template struct SimplifiedTape<Simplifier::One>;
 template struct SimplifiedTape<Simplifier::BatchCompact>;
 template struct SimplifiedTape<Simplifier::BatchTrace>;
 template struct SimplifiedTape<Simplifier::SignOnly>;
+template struct SimplifiedTape<Simplifier::MinChain>;
 
 // --- intervals ---
 

@@ -44,7 +44,9 @@ struct BatchVm {
 // full program's floats at every point of the box. Three ways to simplify:
 // SignOnly: simplify_batch(compact) of a tape marked for its sign alone (Tape::mark_sign_only,
 // as the 2D renderer does): not the same floats, only the same "< 0" at every point.
-enum class Simplifier { One, BatchCompact, BatchTrace, SignOnly };  // simplify(), simplify_batch(compact), (trace)
+// MinChain: simplify_batch(compact) after prune_min_chains (Tape::mark_min_chains, as the
+// tape tree does): the same floats.
+enum class Simplifier { One, BatchCompact, BatchTrace, SignOnly, MinChain };
 template <Simplifier S>
 struct SimplifiedTape {
     static constexpr bool kVmFloats = true;
@@ -59,6 +61,7 @@ using SimplifyOne = SimplifiedTape<Simplifier::One>;
 using SimplifyBatchCompact = SimplifiedTape<Simplifier::BatchCompact>;
 using SimplifyBatchTrace = SimplifiedTape<Simplifier::BatchTrace>;
 using SimplifySignOnly = SimplifiedTape<Simplifier::SignOnly>;
+using SimplifyMinChain = SimplifiedTape<Simplifier::MinChain>;
 
 // The GLSL emitter (compiler/glsl/glsl_emit.hpp) on Mesa llvmpipe: each case is a fragment
 // shader that reads the points from a float texture and writes the value's bits as RGBA8.

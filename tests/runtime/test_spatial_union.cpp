@@ -3,6 +3,7 @@
 // programs once interval arithmetic simplifies them over a small box.
 #include <catch2/catch.hpp>
 
+#include <bit>
 #include <cmath>
 #include <random>
 #include <string>
@@ -26,18 +27,23 @@ std::string grid(int k, bool far_floor) {
            "]) translate([(i + 0.5) * c - 8, 0.35 * c, (j + 0.5) * c - 8]) sphere(0.35 * c);\n" + (far_floor ? "}\n" : "");
 }
 
-// Length of the distance program simplified for the cube of side s around (x, y, z).
-size_t tape_in_box(const CompiledScene& cs, float x, float y, float z, float s) {
+// The distance program simplified for the cube of side s around (x, y, z); `chains`: with
+// the union pruned as a whole (Tape::mark_min_chains, as the tape tree does).
+Tape tape_for_box(const CompiledScene& cs, float x, float y, float z, float s, bool chains = false) {
     Tape t = Tape::from(cs.distance, 0);
     t.link();
+    if (chains) t.mark_min_chains();
     const float xlo = x - s / 2, xhi = x + s / 2, ylo = y - s / 2, yhi = y + s / 2, zlo = z - s / 2, zhi = z + s / 2;
     IntervalEvaluator iv(t.num_regs, t.choices);
+    iv.keep_chains(chains);
     iv.eval(t, &xlo, &xhi, &ylo, &yhi, &zlo, &zhi, 1);
+    iv.prune_min_chains(t, 1);
     Tape out;
     SimplifyScratch sc;
     simplify(t, iv.choices(), iv.stride(), 0, out, sc);
-    return out.code.size();
+    return out;
 }
+size_t tape_in_box(const CompiledScene& cs, float x, float y, float z, float s) { return tape_for_box(cs, x, y, z, s).code.size(); }
 
 }  // namespace
 
@@ -116,4 +122,23 @@ TEST_CASE("spatial union: the batch VM skips a guarded region only when every po
     v.guards = nullptr;
     ev.eval(v, xs, ys, zs, kBatch);
     for (int i = 0; i < kBatch; ++i) CHECK(ev.output(v)[i] == 0.5f);
+}
+
+TEST_CASE("spatial union: pruned as a whole, a small box keeps the spheres near it, with the same floats", "[union][interval]") {
+    auto c = test::compile_text(grid(100, false));
+    const size_t full = c->cs.distance.code.size();
+    const float x = 0.08f, y = 0.06f, z = 0.08f, s = 0.5f;
+    const Tape alone = tape_for_box(c->cs, x, y, z, s), whole = tape_for_box(c->cs, x, y, z, s, true);
+    INFO(whole.code.size() << " against " << alone.code.size() << " of " << full);
+    // Each min against the nearest sphere anywhere in the union, not only its sibling's.
+    CHECK(whole.code.size() * 2 < alone.code.size());
+    Evaluator ev(c->cs.distance);
+    BatchVM vm(1);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+    float xs[kBatch], ys[kBatch], zs[kBatch];
+    for (int i = 0; i < kBatch; ++i) xs[i] = x + s * u(rng), ys[i] = y + s * u(rng), zs[i] = z + s * u(rng);
+    ev.eval(xs, ys, zs, kBatch);
+    vm.eval(whole.view(), xs, ys, zs, kBatch);
+    for (int i = 0; i < kBatch; ++i) CHECK(std::bit_cast<uint32_t>(vm.output(whole.view())[i]) == std::bit_cast<uint32_t>(ev.output(0)[i]));
 }
