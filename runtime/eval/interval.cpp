@@ -464,7 +464,7 @@ SDFC_ISA_END
 #endif
 
 namespace {
-using RunFn = void (*)(const TapeView&, float*, float*, uint8_t*, float*, const float*, const float*, const float*,
+using RunFn = void (*)(const TapeView&, float*, float*, uint8_t*, float*, uint8_t*, const float*, const float*, const float*,
                        const float*, const float*, const float*, int, int, float);
 const RunFn kKernels[] = {
     iv_baseline::run,
@@ -530,8 +530,9 @@ void IntervalEvaluator::eval(const TapeView& t, const float* xlo, const float* x
     if (keep_chains_) {
         if (chain_.size() < size_t(nch) * 4 * size_t(m)) chain_.resize(size_t(nch) * 4 * size_t(m));
         cv = chain_.data();
+        std::fill_n(chain_unknown_, kIvLanes, uint8_t(0));
     }
-    kernels()(t, lo_, hi_, choices_.get(), cv, xlo, xhi, ylo, yhi, zlo, zhi, n, m, time);
+    kernels()(t, lo_, hi_, choices_.get(), cv, chain_unknown_, xlo, xhi, ylo, yhi, zlo, zhi, n, m, time);
 }
 
 // Top-down over the chain: bound[i] is an upper bound, over the box, of the rest of the
@@ -546,13 +547,7 @@ void IntervalEvaluator::prune_min_chains(const Tape& t, int n) {
     const size_t len = t.code.size(), m = size_t(stride_);
     if (!(t.code[t.out_def].pad & kMinChain) || t.code[t.out_def].op != Op::Min) return;
     uint64_t bad = 0;  // lanes with an unknown interval in the chain
-    for (size_t i = 0; i < len; ++i) {
-        if (!(t.code[i].pad & kMinChain) || t.code[i].op != Op::Min) continue;
-        const float* cv = chain_.data() + size_t(t.links[i].slot) * 4 * m;
-        for (int j = 0; j < n; ++j)
-            if (std::isnan(cv[j]) || std::isnan(cv[m + j]) || std::isnan(cv[2 * m + j]) || std::isnan(cv[3 * m + j]))
-                bad |= uint64_t(1) << j;
-    }
+    for (int j = 0; j < n; ++j) bad |= uint64_t(chain_unknown_[j] != 0) << j;
     if (bad == (n == 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1)) return;
     bound_.assign(len * m, kInf);
     uint8_t* choices = choices_.get();

@@ -6,7 +6,8 @@
 // Chain: also keeps the operands' intervals (al, ah, bl, bh: 4 rows of m) for
 // prune_min_chains.
 template <Op O, bool SignOnly, bool Chain>
-SDFC_IV_INLINE void choice_op(const Instr& in, float* const L, float* const H, uint8_t* chp, float* cv, int m) {
+SDFC_IV_INLINE void choice_op(const Instr& in, float* const L, float* const H, uint8_t* chp, float* cv, uint8_t* unknown,
+                              int m) {
     float* rl = L + size_t(in.out) * kIvLanes;
     float* rh = H + size_t(in.out) * kIvLanes;
     const float* al = L + size_t(in.a) * kIvLanes;
@@ -27,6 +28,7 @@ SDFC_IV_INLINE void choice_op(const Instr& in, float* const L, float* const H, u
             cv[m + i] = ah[i];
             cv[2 * m + i] = bl[i];
             cv[3 * m + i] = bh[i];
+            unknown[i] |= uint8_t((al[i] != al[i]) | (ah[i] != ah[i]) | (bl[i] != bl[i]) | (bh[i] != bh[i]));
         }
         rl[i] = lo;
         rh[i] = hi;
@@ -34,7 +36,7 @@ SDFC_IV_INLINE void choice_op(const Instr& in, float* const L, float* const H, u
     }
 }
 
-void run(const TapeView& t, float* const L, float* const H, uint8_t* chp, float* cv, const float* xlo, const float* xhi, const float* ylo,
+void run(const TapeView& t, float* const L, float* const H, uint8_t* chp, float* cv, uint8_t* unknown, const float* xlo, const float* xhi, const float* ylo,
          const float* yhi, const float* zlo, const float* zhi, int n, int m, float time) {
     auto input = [&](const Instr& in, const float* l, const float* h) {
         float* rl = L + size_t(in.out) * kIvLanes;
@@ -67,11 +69,11 @@ void run(const TapeView& t, float* const L, float* const H, uint8_t* chp, float*
         } else {                                                                            \
             if constexpr (is_choice_op(Op::name)) {                                         \
                 if (Op::name == Op::Min && cv && (in.pad & kMinChain))                      \
-                    choice_op<Op::name, false, true>(in, L, H, chp, cv, m);                 \
+                    choice_op<Op::name, false, true>(in, L, H, chp, cv, unknown, m);        \
                 else if (in.pad & kSignOnly)                                                \
-                    choice_op<Op::name, true, false>(in, L, H, chp, cv, m);                 \
+                    choice_op<Op::name, true, false>(in, L, H, chp, cv, unknown, m);        \
                 else                                                                        \
-                    choice_op<Op::name, false, false>(in, L, H, chp, cv, m);                \
+                    choice_op<Op::name, false, false>(in, L, H, chp, cv, unknown, m);       \
                 chp += m;                                                                   \
                 if (cv) cv += 4 * m;                                                        \
             } else {                                                                        \
