@@ -16,7 +16,8 @@ SDFC_IV_INLINE bool guard_skips_lane(const Guard& g, float box, float x, float y
     const float ez = std::max(std::max(g.lo[2] - z, z - g.hi[2]), 0.0f);
     const float e2 = ex * ex + ey * ey + ez * ez;
     const float need = thr + 0x1p-14f * (1.0f + box + std::fabs(x) + std::fabs(y) + std::fabs(z) + std::fabs(thr));
-    return need > 0.0f && e2 >= need * need;  // NaN or +inf: never skips
+    // NaN, +inf or beyond 1e18 (where the squares could overflow): never skips.
+    return need > 0.0f && need < 1e18f && e2 >= need * need;
 }
 inline bool guard_skips_all(const Guard& g, const float* base, const float* thr, int n) {
     const float* px = base + static_cast<size_t>(g.px) * kBatch;

@@ -85,27 +85,31 @@ TEST_CASE("spatial union: the batch VM skips a guarded region only when every po
           "[union][guard]") {
     // A region that lies (its value 0.5 is below its box's distance) shows whether it ran:
     // min(1, region) is 0.5 when it ran, 1 when it was skipped.
-    Program p;
-    auto add = [&](Op op, uint16_t out, uint16_t a = 0, uint16_t b = 0, float k = 0.0f) {
-        Instr in{op};
-        in.out = out, in.a = a, in.b = b, in.k = k;
-        p.code.push_back(in);
+    auto program = [](float threshold) {
+        Program p;
+        auto add = [&](Op op, uint16_t out, uint16_t a = 0, uint16_t b = 0, float k = 0.0f) {
+            Instr in{op};
+            in.out = out, in.a = a, in.b = b, in.k = k;
+            p.code.push_back(in);
+        };
+        add(Op::VarX, 0), add(Op::VarY, 1), add(Op::VarZ, 2);
+        add(Op::Const, 3, 0, 0, threshold);  // the union's distance so far
+        add(Op::Guard, 4, 3, 0, 0.0f);       // guards[0]
+        add(Op::Const, 4, 0, 0, 0.5f);       // the region
+        add(Op::Min, 5, 3, 4);
+        Guard g;
+        g.px = 0, g.py = 1, g.pz = 2;
+        g.lo[0] = g.lo[1] = g.lo[2] = 10.0f;
+        g.hi[0] = g.hi[1] = g.hi[2] = 11.0f;
+        g.end = 6;
+        p.guards.push_back(g);
+        p.locs.resize(p.code.size());
+        p.num_regs = 6;
+        p.outputs = {5};
+        p.output_names = {"out"};
+        return p;
     };
-    add(Op::VarX, 0), add(Op::VarY, 1), add(Op::VarZ, 2);
-    add(Op::Const, 3, 0, 0, 1.0f);  // the union's distance so far: the threshold
-    add(Op::Guard, 4, 3, 0, 0.0f);  // guards[0]
-    add(Op::Const, 4, 0, 0, 0.5f);  // the region
-    add(Op::Min, 5, 3, 4);
-    Guard g;
-    g.px = 0, g.py = 1, g.pz = 2;
-    g.lo[0] = g.lo[1] = g.lo[2] = 10.0f;
-    g.hi[0] = g.hi[1] = g.hi[2] = 11.0f;
-    g.end = 6;
-    p.guards.push_back(g);
-    p.locs.resize(p.code.size());
-    p.num_regs = 6;
-    p.outputs = {5};
-    p.output_names = {"out"};
+    const Program p = program(1.0f);
     Evaluator ev(p);
     float xs[kBatch], ys[kBatch], zs[kBatch];
     for (int i = 0; i < kBatch; ++i) xs[i] = ys[i] = zs[i] = 0.01f * float(i);  // 15.6 .. 17.3 from the box
@@ -122,6 +126,12 @@ TEST_CASE("spatial union: the batch VM skips a guarded region only when every po
     v.guards = nullptr;
     ev.eval(v, xs, ys, zs, kBatch);
     for (int i = 0; i < kBatch; ++i) CHECK(ev.output(v)[i] == 0.5f);
+    // Huge: 2e19 from the box, the threshold 3e19; squared, both overflow to +inf.
+    const Program huge = program(3e19f);
+    Evaluator eh(huge);
+    for (int i = 0; i < kBatch; ++i) xs[i] = -2e19f, ys[i] = zs[i] = 10.5f;
+    eh.eval(xs, ys, zs, kBatch);
+    for (int i = 0; i < kBatch; ++i) CHECK(eh.output(0)[i] == 0.5f);  // ran
 }
 
 TEST_CASE("spatial union: pruned as a whole, a small box keeps the spheres near it, with the same floats", "[union][interval]") {
