@@ -33,6 +33,17 @@ inline std::unique_ptr<Compiled> compile_text(const std::string& src, const std:
 
 // out := op(r0, r1, r2, k) with r0..r2 = x, y, z: one opcode alone, for walking the opcode
 // table through every backend.
+// A guard over the cube [lo, hi]^3 around the point in registers 0, 1, 2, its region ending
+// before instruction `end`.
+inline Guard cube_guard(float lo, float hi, uint32_t end) {
+    Guard g;
+    g.px = 0, g.py = 1, g.pz = 2;
+    g.lo[0] = g.lo[1] = g.lo[2] = lo;
+    g.hi[0] = g.hi[1] = g.hi[2] = hi;
+    g.end = end;
+    return g;
+}
+
 inline Program single_op_program(Op op, float k) {
     Program p;
     p.code.push_back(Instr{Op::VarX, 0, 0});
@@ -42,12 +53,7 @@ inline Program single_op_program(Op op, float k) {
     in.out = 3, in.a = 0, in.b = 1, in.c = 2, in.k = k;
     if (op == Op::Guard) {  // a guard whose region is empty: +inf whether it skips or not
         in.k = 0.0f;
-        Guard g;
-        g.px = 0, g.py = 1, g.pz = 2;
-        g.lo[0] = g.lo[1] = g.lo[2] = -1.0f;
-        g.hi[0] = g.hi[1] = g.hi[2] = 1.0f;
-        g.end = 4;
-        p.guards.push_back(g);
+        p.guards.push_back(cube_guard(-1.0f, 1.0f, 4));
     }
     p.code.push_back(in);
     p.locs.resize(p.code.size());

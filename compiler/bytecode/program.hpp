@@ -14,7 +14,7 @@ namespace sdfc {
 
 struct Instr {
     Op op;
-    uint8_t pad = 0;  // evaluator hints (runtime/eval/tape.hpp: kSignOnly); the VM ignores them
+    uint8_t pad = 0;  // evaluator hints (runtime/eval/tape.hpp: kSignOnly, kMinChain); the VM ignores them
     uint16_t out = 0, a = 0, b = 0, c = 0;
     float k = 0.0f;
 };

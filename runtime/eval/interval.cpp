@@ -545,21 +545,21 @@ void IntervalEvaluator::eval(const TapeView& t, const float* xlo, const float* x
 void IntervalEvaluator::prune_min_chains(const Tape& t, int n) {
     if (!keep_chains_ || !t.linked || t.out_def == Tape::kNone) return;
     const size_t len = t.code.size(), m = size_t(stride_);
-    if (!(t.code[t.out_def].pad & kMinChain) || t.code[t.out_def].op != Op::Min) return;
+    if (!is_chain_min(t.code[t.out_def])) return;
     uint64_t bad = 0;  // lanes with an unknown interval in the chain
     for (int j = 0; j < n; ++j) bad |= uint64_t(chain_unknown_[j] != 0) << j;
     if (bad == (n == 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1)) return;
-    bound_.assign(len * m, kInf);
+    bound_.assign(size_t(t.choices) * m, kInf);  // per choice slot
     uint8_t* choices = choices_.get();
-    auto chain_min = [&](uint32_t d) { return d != Tape::kNone && t.code[d].op == Op::Min && (t.code[d].pad & kMinChain); };
+    auto bound_of = [&](uint32_t d) { return is_chain_min(t.code[d]) ? bound_.data() + size_t(t.links[d].slot) * m : nullptr; };
     for (size_t i = len; i-- > 0;) {
-        if (!(t.code[i].pad & kMinChain) || t.code[i].op != Op::Min) continue;
+        if (!is_chain_min(t.code[i])) continue;
         const Tape::Link& l = t.links[i];
         const float* cv = chain_.data() + size_t(l.slot) * 4 * m;
         uint8_t* ch = choices + size_t(l.slot) * m;
-        const float* B = bound_.data() + i * m;
-        float* Ba = chain_min(l.def[0]) ? bound_.data() + size_t(l.def[0]) * m : nullptr;
-        float* Bb = chain_min(l.def[1]) ? bound_.data() + size_t(l.def[1]) * m : nullptr;
+        const float* B = bound_.data() + size_t(l.slot) * m;
+        float* Ba = bound_of(l.def[0]);
+        float* Bb = bound_of(l.def[1]);
         for (int j = 0; j < n; ++j) {
             if ((bad >> j) & 1) continue;
             const float al = cv[j], ah = cv[m + j], bl = cv[2 * m + j], bh = cv[3 * m + j];

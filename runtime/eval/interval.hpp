@@ -75,7 +75,7 @@ private:
     uint16_t out_ = 0;
     bool keep_chains_ = false;
     std::vector<float> chain_;  // per choice slot: al, ah, bl, bh rows of stride_ lanes
-    std::vector<float> bound_;  // prune_min_chains: per instruction and lane
+    std::vector<float> bound_;  // prune_min_chains: per choice slot and lane
     uint8_t chain_unknown_[kIvLanes] = {};  // per lane: some chain operand's interval is unknown (NaN)
 };
 

@@ -68,7 +68,7 @@ void run(const TapeView& t, float* const L, float* const H, uint8_t* chp, float*
             std::fill_n(rh, m, time);                                                       \
         } else {                                                                            \
             if constexpr (is_choice_op(Op::name)) {                                         \
-                if (Op::name == Op::Min && cv && (in.pad & kMinChain))                      \
+                if (cv && is_chain_min(in))                                                 \
                     choice_op<Op::name, false, true>(in, L, H, chp, cv, unknown, m);        \
                 else if (in.pad & kSignOnly)                                                \
                     choice_op<Op::name, true, false>(in, L, H, chp, cv, unknown, m);        \

@@ -39,6 +39,7 @@ inline constexpr uint8_t kSignOnly = 1;
 // result: IntervalEvaluator::prune_min_chains drops it even where its sibling's interval
 // overlaps it (a union's far shapes, against the nearest shape anywhere in the union).
 inline constexpr uint8_t kMinChain = 2;
+inline bool is_chain_min(const Instr& in) { return in.op == Op::Min && (in.pad & kMinChain); }
 
 // A straight-line program with one output: a Program's output, or a shortened copy.
 // link() adds what simplify() needs to visit only the live part of a tape: for every

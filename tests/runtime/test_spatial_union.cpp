@@ -97,12 +97,7 @@ TEST_CASE("spatial union: the batch VM skips a guarded region only when every po
         add(Op::Guard, 4, 3, 0, 0.0f);       // guards[0]
         add(Op::Const, 4, 0, 0, 0.5f);       // the region
         add(Op::Min, 5, 3, 4);
-        Guard g;
-        g.px = 0, g.py = 1, g.pz = 2;
-        g.lo[0] = g.lo[1] = g.lo[2] = 10.0f;
-        g.hi[0] = g.hi[1] = g.hi[2] = 11.0f;
-        g.end = 6;
-        p.guards.push_back(g);
+        p.guards.push_back(test::cube_guard(10.0f, 11.0f, 6));
         p.locs.resize(p.code.size());
         p.num_regs = 6;
         p.outputs = {5};
