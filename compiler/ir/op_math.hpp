@@ -18,7 +18,21 @@ inline float min_(float a, float b) { return b < a ? b : a; }
 inline float max_(float a, float b) { return a < b ? b : a; }
 inline float sign(float a) { return a > 0.0f ? 1.0f : (a < 0.0f ? -1.0f : 0.0f); }
 inline float mod_(float a, float b) { return a - b * std::floor(a / b); }
-inline float pow_(float a, float b) { return std::pow(a, b); }
+// The transcendentals (op_math.cpp): SLEEF's deterministic, FMA-free functions of 1 ulp
+// ("cinz"), whose 4-, 8- and 16-lane versions return the same bits as these scalar ones for
+// every input (NaN payloads aside), so the batch VM runs them a vector at a time
+// (runtime/eval/vmath.inl) and stays bit for bit the scalar reference and the constant
+// folder. Special values as C's libm (pow(-8, 3) = -512, pow(x, 0) = 1, log(-1) = NaN).
+float exp_(float a);
+float log_(float a);
+float sin_(float a);
+float cos_(float a);
+float tan_(float a);
+float asin_(float a);
+float acos_(float a);
+float atan_(float a);
+float atan2_(float a, float b);
+float pow_(float a, float b);
 
 // Gradient noise (Perlin's improved noise with an integer hash instead of a permutation
 // table, so GLSL computes the same bits: noise.glsl, its twin). Range about [-1, 1]; Lipschitz bound kNoiseLipschitz.

@@ -50,7 +50,7 @@ private:
     std::vector<int> ev_n_;
     std::vector<uint32_t> local_, sh_idx_;
     std::vector<float> lw_, lnx_, lny_, lnz_, ao_, lrad_;
-    uint32_t pleaf_[kWindow];
+    uint32_t pleaf_[kWindow], merged_[kWindow];
     int kind_ = RenderStats::kRays;  // what the distance evaluations are for (stats)
     alignas(64) float gx_[kBatch], gy_[kBatch], gz_[kBatch];
 
@@ -71,13 +71,20 @@ private:
         stats.distance_instructions += static_cast<uint64_t>(n) * lf.len;
     }
 
-    // Distances at n <= kWindow points whose leaves are leaf[0, n): one batch per leaf.
+    // Distances at n <= kWindow points whose leaves are leaf[0, n): one batch per leaf, but
+    // for the leaves whose tapes save less than their own batch costs (regroup).
     void eval_grouped(const float* x, const float* y, const float* z, const uint32_t* leaf, int n, float* out) {
         bool same = true;
         for (int i = 1; i < n; ++i) same &= leaf[i] == leaf[0];
         if (same) return eval_leaf(leaf[0], x, y, z, n, out);
         Buckets& B = *buckets_;
         B.build(leaf, n);
+        if (regroup(B, leaf, n)) {
+            same = true;
+            for (int i = 1; i < n; ++i) same &= merged_[i] == merged_[0];
+            if (same) return eval_leaf(merged_[0], x, y, z, n, out);
+            B.build(merged_, n);
+        }
         for (int b = 0; b < B.nb; ++b) {
             const TapeTree::Leaf& lf = T_.leaves[B.key_of[b]];
             const TapeView tape = lf.view();
@@ -94,6 +101,28 @@ private:
             stats.distance_points_by[kind_] += cnt;
             stats.distance_instructions += cnt * lf.len;
         }
+    }
+
+    // Whether some of B's groups had better run with leaf 0's tape (the whole program, with
+    // its guards, which gives the same floats everywhere); then merged_ holds the lanes'
+    // leaves with those groups' moved to 0. A group's own batch pays for gathering and for
+    // its padding lanes (the VM computes lanes in groups of 8): worth it only for a tape
+    // clearly shorter than the whole program's (bear.vm's leaves keep 517 of its 525
+    // instructions, and splitting its windows into small batches cost a fifth of its time).
+    bool regroup(const Buckets& B, const uint32_t* leaf, int n) {
+        constexpr uint64_t kGroupCost = 128;  // gathering, scattering, a call: in instruction-lanes
+        const uint64_t whole = T_.leaves[0].len;
+        bool to_root[kWindow], any = false;
+        for (int b = 0; b < B.nb; ++b) {
+            const uint32_t id = B.key_of[b];
+            const uint64_t c = static_cast<uint64_t>(B.start[b + 1] - B.start[b]), len = T_.leaves[id].len;
+            const uint64_t padded = (c + 7) / 8 * 8;
+            to_root[b] = id != 0 && (8 * len >= 7 * whole || len * padded + kGroupCost >= whole * c);
+            any |= to_root[b];
+        }
+        if (!any) return false;
+        for (int i = 0; i < n; ++i) merged_[i] = to_root[B.bucket[i]] ? 0u : leaf[i];
+        return true;
     }
 
     // Distance at `count` arbitrary points (each batch grouped by leaf).

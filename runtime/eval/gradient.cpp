@@ -34,26 +34,8 @@ inline bool operator!=(const D& a, const D& b) { return a.v != b.v; }
 // Dual twins of what opcodes.def's semantics call, under the names they call them by.
 namespace std {
 inline D fabs(const D& a) { return a.v < 0.0f ? -a : a; }
-inline D sin(const D& a) { return scale(a, ::std::sin(a.v), ::std::cos(a.v)); }
-inline D cos(const D& a) { return scale(a, ::std::cos(a.v), -::std::sin(a.v)); }
-inline D tan(const D& a) {
-    const float c = ::std::cos(a.v);
-    return scale(a, ::std::tan(a.v), 1.0f / (c * c));
-}
-inline D asin(const D& a) { return scale(a, ::std::asin(a.v), 1.0f / ::std::sqrt(1.0f - a.v * a.v)); }
-inline D acos(const D& a) { return scale(a, ::std::acos(a.v), -1.0f / ::std::sqrt(1.0f - a.v * a.v)); }
-inline D atan(const D& a) { return scale(a, ::std::atan(a.v), 1.0f / (1.0f + a.v * a.v)); }
-inline D exp(const D& a) {
-    const float e = ::std::exp(a.v);
-    return scale(a, e, e);
-}
-inline D log(const D& a) { return scale(a, ::std::log(a.v), 1.0f / a.v); }
 inline D floor(const D& a) { return D(::std::floor(a.v)); }
 inline D ceil(const D& a) { return D(::std::ceil(a.v)); }
-inline D atan2(const D& a, const D& b) {
-    const float r = 1.0f / (a.v * a.v + b.v * b.v);
-    return D(::std::atan2(a.v, b.v), (b.v * a.x - a.v * b.x) * r, (b.v * a.y - a.v * b.y) * r, (b.v * a.z - a.v * b.z) * r);
-}
 }  // namespace std
 
 namespace om {
@@ -69,11 +51,31 @@ inline D min_(const D& a, const D& b) { return b.v < a.v ? b : a; }
 inline D max_(const D& a, const D& b) { return a.v < b.v ? b : a; }
 inline D sign(const D& a) { return D(::sdfc::om::sign(a.v)); }
 inline D mod_(const D& a, const D& b) { return a - b * std::floor(a / b); }
+// The transcendentals: values from op_math's (the VM's bits), derivatives from them.
+inline D sin_(const D& a) { return scale(a, ::sdfc::om::sin_(a.v), ::sdfc::om::cos_(a.v)); }
+inline D cos_(const D& a) { return scale(a, ::sdfc::om::cos_(a.v), -::sdfc::om::sin_(a.v)); }
+inline D tan_(const D& a) {
+    const float c = ::sdfc::om::cos_(a.v);
+    return scale(a, ::sdfc::om::tan_(a.v), 1.0f / (c * c));
+}
+inline D asin_(const D& a) { return scale(a, ::sdfc::om::asin_(a.v), 1.0f / ::std::sqrt(1.0f - a.v * a.v)); }
+inline D acos_(const D& a) { return scale(a, ::sdfc::om::acos_(a.v), -1.0f / ::std::sqrt(1.0f - a.v * a.v)); }
+inline D atan_(const D& a) { return scale(a, ::sdfc::om::atan_(a.v), 1.0f / (1.0f + a.v * a.v)); }
+inline D exp_(const D& a) {
+    const float e = ::sdfc::om::exp_(a.v);
+    return scale(a, e, e);
+}
+inline D log_(const D& a) { return scale(a, ::sdfc::om::log_(a.v), 1.0f / a.v); }
+inline D atan2_(const D& a, const D& b) {
+    const float r = 1.0f / (a.v * a.v + b.v * b.v);
+    return D(::sdfc::om::atan2_(a.v, b.v), (b.v * a.x - a.v * b.x) * r, (b.v * a.y - a.v * b.y) * r,
+             (b.v * a.z - a.v * b.z) * r);
+}
 inline D pow_(const D& a, const D& b) {
     const float p = ::sdfc::om::pow_(a.v, b.v);
     const float da = b.v * ::sdfc::om::pow_(a.v, b.v - 1.0f);
     const bool db0 = b.x == 0.0f && b.y == 0.0f && b.z == 0.0f;  // a constant exponent: no log(a)
-    const float db = db0 ? 0.0f : p * ::std::log(a.v);
+    const float db = db0 ? 0.0f : p * ::sdfc::om::log_(a.v);
     return D(p, da * a.x + db * b.x, da * a.y + db * b.y, da * a.z + db * b.z);
 }
 // Noise's gradient by central differences of the float noise (its derivative is smooth).

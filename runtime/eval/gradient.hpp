@@ -1,7 +1,7 @@
 // Forward-mode gradients over the same bytecode as the batch VM: every register holds a
 // value and its derivatives by x, y and z (a dual number). Each op's derivative comes from
 // opcodes.def's own semantics column, expanded once more over dual numbers (gradient.cpp):
-// the column's calls (std::exp, om::min_, ...) resolve to dual twins there, so an opcode
+// the column's calls (om::exp_, om::min_, std::floor, ...) resolve to dual twins there, so an opcode
 // whose semantics call a function without a twin does not compile. Exact normals for the
 // mesher, one evaluation per point instead of six.
 #pragma once

@@ -5,9 +5,8 @@
 // and rounds once (add, sub, mul, min, max, sqrt, square, ...), computing the interval's
 // ends with the same float operation as the VM gives bounds that enclose the VM's results
 // exactly, with no outward rounding. Ops whose VM form may round more than once, or may be
-// contracted into an FMA by the compiler (MulAddI, Mix, Length2/3, Mod), and libm functions
-// (which may differ by an ulp between the scalar and a vectorised libm) are widened by a
-// few ulps. Min/max choices compare the interval ends with the same comparisons the VM's
+// contracted into an FMA by the compiler (MulAddI, Mix, Length2/3, Mod), and the transcendentals
+// (om::exp_ and the like, not proven monotonic to the ulp) are widened by a few ulps. Min/max choices compare the interval ends with the same comparisons the VM's
 // om::min_ / om::max_ make, so a decided choice is the VM's choice at every point.
 #include "runtime/eval/interval.hpp"
 
@@ -100,8 +99,8 @@ SDFC_IV_INLINE void sin_iv(float l, float h, float peak_at, float (*f)(float), f
     hi = mn(hi, 1.0f);
 }
 
-float sinf_(float x) { return std::sin(x); }
-float cosf_(float x) { return std::cos(x); }
+float sinf_(float x) { return om::sin_(x); }
+float cosf_(float x) { return om::cos_(x); }
 
 // Unknown intervals. Invariant: if a point of the box may give NaN, or the interval is
 // unknown, both ends are NaN; NaN ends never decide a choice (comparisons are false). An
@@ -159,24 +158,24 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
             const double pi = 3.141592653589793;
             bool ok = ah - al < 3.0f && std::fabs(al) < 1e5f && std::fabs(ah) < 1e5f &&
                       std::floor((double(ah) + 1e-3 - pi / 2) / pi) < std::ceil((double(al) - 1e-3 - pi / 2) / pi);
-            lo = ok ? dnw(std::tan(al)) : -kInf;
-            hi = ok ? upw(std::tan(ah)) : kInf;
+            lo = ok ? dnw(om::tan_(al)) : -kInf;
+            hi = ok ? upw(om::tan_(ah)) : kInf;
             break;
         }
         case Op::Asin:
-            mono_inc([](float v) { return std::asin(om::clamp1(v)); }, al, ah, lo, hi);
+            mono_inc([](float v) { return om::asin_(om::clamp1(v)); }, al, ah, lo, hi);
             break;
         case Op::Acos:
-            lo = dnw(std::acos(om::clamp1(ah)));
-            hi = upw(std::acos(om::clamp1(al)));
+            lo = dnw(om::acos_(om::clamp1(ah)));
+            hi = upw(om::acos_(om::clamp1(al)));
             break;
-        case Op::Atan: mono_inc([](float v) { return std::atan(v); }, al, ah, lo, hi); break;
+        case Op::Atan: mono_inc([](float v) { return om::atan_(v); }, al, ah, lo, hi); break;
         case Op::Exp:
-            mono_inc([](float v) { return std::exp(v); }, al, ah, lo, hi);
+            mono_inc([](float v) { return om::exp_(v); }, al, ah, lo, hi);
             lo = mx(lo, 0.0f);
             break;
         case Op::Log:
-            mono_inc([](float v) { return std::log(v); }, mx(al, 0.0f), mx(ah, 0.0f), lo, hi);
+            mono_inc([](float v) { return om::log_(v); }, mx(al, 0.0f), mx(ah, 0.0f), lo, hi);
             z = al < 0.0f ? kNaN : z;
             break;
         case Op::Floor: lo = std::floor(al); hi = std::floor(ah); break;
@@ -240,7 +239,7 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
         }
         case Op::Pow: {
             // For a > 0, pow is monotonic in each operand: the extremes are at corners.
-            float p0 = std::pow(al, bl), p1 = std::pow(al, bh), p2 = std::pow(ah, bl), p3 = std::pow(ah, bh);
+            float p0 = om::pow_(al, bl), p1 = om::pow_(al, bh), p2 = om::pow_(ah, bl), p3 = om::pow_(ah, bh);
             lo = dnw(mn(mn(p0, p1), mn(p2, p3)));
             hi = upw(mx(mx(p0, p1), mx(p2, p3)));
             z = al > 0.0f ? z : kNaN;
@@ -353,7 +352,7 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
         }
         case Op::PowI: {
             // Integer exponents: even like a square, odd monotonic; other exponents need a >= 0.
-            float pl = std::pow(al, k), ph = std::pow(ah, k);
+            float pl = om::pow_(al, k), ph = om::pow_(ah, k);
             bool integer = k == std::floor(k) && std::fabs(k) < 16777216.0f;
             bool even = integer && std::fmod(k, 2.0f) == 0.0f;
             bool spans0 = (al < 0.0f) & (ah > 0.0f);

@@ -6,6 +6,9 @@
 #include <cstring>
 #include <iterator>
 #include <new>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #include "runtime/eval/isa.hpp"
 #include "runtime/eval/simd.hpp"
@@ -40,21 +43,40 @@ void BatchVM::reserve(uint32_t regs) {
     max_regs_ = regs;
 }
 
-// The kernel for each instruction set the build carries (runtime/eval/isa.hpp).
+// The kernel for each instruction set the build carries (runtime/eval/isa.hpp), with the
+// vector width of its transcendentals (runtime/eval/vmath.inl): the AVX2 copy takes SLEEF's
+// AVX functions, as the FMA-free family has no AVX2 member.
+#if defined(__AVX512F__)
+#define SDFC_VMATH_LANES 16
+#elif defined(__AVX__)
+#define SDFC_VMATH_LANES 8
+#elif defined(__SSE2__)
+#define SDFC_VMATH_LANES 4
+#else
+#define SDFC_VMATH_LANES 1
+#endif
 namespace isa_baseline {
+#include "runtime/eval/vmath.inl"
 #include "runtime/eval/vm_kernel.inl"
 }  // namespace isa_baseline
+#undef SDFC_VMATH_LANES
 #if defined(SDFC_ISA_DISPATCH)
+#define SDFC_VMATH_LANES 8
 SDFC_ISA_BEGIN_AVX2
 namespace isa_avx2 {
+#include "runtime/eval/vmath.inl"
 #include "runtime/eval/vm_kernel.inl"
 }  // namespace isa_avx2
 SDFC_ISA_END
+#undef SDFC_VMATH_LANES
+#define SDFC_VMATH_LANES 16
 SDFC_ISA_BEGIN_AVX512
 namespace isa_avx512 {
+#include "runtime/eval/vmath.inl"
 #include "runtime/eval/vm_kernel.inl"
 }  // namespace isa_avx512
 SDFC_ISA_END
+#undef SDFC_VMATH_LANES
 #endif
 
 namespace {

@@ -79,6 +79,8 @@ inline void run(const Instr* code, const Instr* end, const Guard* guards, float*
             const bool skip = g && guard_skips_all(*g, base, A, n);                \
             std::fill_n(R, m, om::kSkipped);                                       \
             if (skip) ip = code + g->end - 1;                                      \
+        } else if constexpr (vmath::kVector<Op::name>) {                           \
+            vmath::apply<Op::name>(R, A, B, k, m);                                 \
         } else {                                                                   \
             SDFC_IVDEP                                                             \
             for (int i = 0; i < m; ++i) {                                          \

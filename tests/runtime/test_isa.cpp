@@ -131,3 +131,69 @@ TEST_CASE("isa: the same picture with every kernel") {
         }
     }
 }
+
+// The transcendentals run a vector at a time (runtime/eval/vmath.inl) through SLEEF's functions
+// of the scalar reference's family: every kernel gives the scalar semantics' bits (NaN for NaN),
+// at special values, at huge arguments (sin's slow reduction), and at random ones.
+TEST_CASE("isa: the transcendental ops give the scalar semantics' bits with every kernel") {
+    Restore r;
+    std::vector<float> xs = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, -0.5f, 2.0f, -8.0f, 3.0f, 1e-40f, -1e-40f, 1e-8f, 88.7f, 89.0f,
+                             -87.3f, -104.0f, 1e5f, -1e5f, 1e30f, 3.4e38f, INFINITY, -INFINITY, NAN, 0.9999999f, 1.0000001f};
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> small(-10.0f, 10.0f);
+    std::uniform_int_distribution<uint32_t> bits;
+    while (xs.size() < 4 * kBatch) {
+        xs.push_back(small(rng));
+        const uint32_t u = bits(rng);
+        float f;
+        std::memcpy(&f, &u, 4);
+        xs.push_back(f);
+    }
+    std::vector<float> ys(xs.rbegin(), xs.rend());  // second operands: every pairing of kinds
+    const float zs[kBatch] = {};
+    auto same = [](float a, float b) { return std::memcmp(&a, &b, 4) == 0 || (std::isnan(a) && std::isnan(b)); };
+    for (Op op : {Op::Exp, Op::Log, Op::Sin, Op::Cos, Op::Tan, Op::Asin, Op::Acos, Op::Atan, Op::Atan2, Op::Pow, Op::PowI}) {
+        for (float k : {3.0f, 0.5f, -2.0f}) {
+            if (op != Op::PowI && k != 3.0f) continue;
+            INFO(op_info(op).mnemonic << " k=" << k);
+            const Program p = test::single_op_program(op, k);
+            BatchVM vm(p.num_regs);
+            for (Isa isa : isas()) {
+                INFO(isa_name(isa));
+                REQUIRE(set_isa(isa) == isa);
+                int wrong = 0;
+                std::string first;
+                for (size_t i0 = 0; i0 < xs.size(); i0 += kBatch) {
+                    const int n = static_cast<int>(std::min<size_t>(kBatch, xs.size() - i0)) - (i0 == 0 ? 5 : 0);  // and a partial batch
+                    vm.eval(p.view(), xs.data() + i0, ys.data() + i0, zs, n, 0.0f);
+                    for (int i = 0; i < n; ++i) {
+                        const float want = eval_op(op, xs[i0 + i], ys[i0 + i], 0.0f, k), got = vm.output(p.view())[i];
+                        if (!same(got, want) && wrong++ == 0)
+                            first = std::to_string(xs[i0 + i]) + ", " + std::to_string(ys[i0 + i]) + ": " + std::to_string(got) +
+                                    " for " + std::to_string(want);
+                    }
+                }
+                CHECK(first == "");
+                CHECK(wrong == 0);
+            }
+        }
+    }
+    // Special values as C's: what scripts may rely on.
+    CHECK(eval_op(Op::Pow, -8.0f, 3.0f, 0.0f, 0.0f) == -512.0f);
+    CHECK(std::isnan(eval_op(Op::Pow, -8.0f, 1.0f / 3.0f, 0.0f, 0.0f)));
+    CHECK(eval_op(Op::Pow, 0.0f, -1.0f, 0.0f, 0.0f) == INFINITY);
+    CHECK(eval_op(Op::Pow, 1.0f, NAN, 0.0f, 0.0f) == 1.0f);
+    CHECK(eval_op(Op::Pow, 2.0f, 0.5f, 0.0f, 0.0f) == std::sqrt(2.0f));
+    CHECK(eval_op(Op::PowI, NAN, 0.0f, 0.0f, 0.0f) == 1.0f);
+    CHECK(eval_op(Op::Exp, 0.0f, 0.0f, 0.0f, 0.0f) == 1.0f);
+    CHECK(eval_op(Op::Exp, -INFINITY, 0.0f, 0.0f, 0.0f) == 0.0f);
+    CHECK(eval_op(Op::Exp, 89.0f, 0.0f, 0.0f, 0.0f) == INFINITY);
+    CHECK(eval_op(Op::Log, 1.0f, 0.0f, 0.0f, 0.0f) == 0.0f);
+    CHECK(eval_op(Op::Log, 0.0f, 0.0f, 0.0f, 0.0f) == -INFINITY);
+    CHECK(std::isnan(eval_op(Op::Log, -1.0f, 0.0f, 0.0f, 0.0f)));
+    CHECK(eval_op(Op::Sin, 0.0f, 0.0f, 0.0f, 0.0f) == 0.0f);
+    CHECK(eval_op(Op::Cos, 0.0f, 0.0f, 0.0f, 0.0f) == 1.0f);
+    CHECK(eval_op(Op::Atan2, 0.0f, -1.0f, 0.0f, 0.0f) == Approx(3.14159265f));
+    CHECK(eval_op(Op::Asin, 2.0f, 0.0f, 0.0f, 0.0f) == Approx(1.57079633f));  // clamped, as GLSL's asin(clamp(...))
+    CHECK(std::fabs(eval_op(Op::Sin, 1e5f, 0.0f, 0.0f, 0.0f) - std::sin(1e5f)) <= 1e-6f);
+}
