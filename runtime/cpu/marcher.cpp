@@ -258,13 +258,16 @@ void Worker::march_raw(const RaySet& rs, bool shadow) {
         [&](uint32_t r) {
             if (!shadow) t_[r] = rs.tmax[r];
         },
-        [&](Lanes& L, int i, float, float te) {
-            // No sign change in an empty leaf: past its exit (a quarter pixel beyond, for
-            // progress); the current point is the outside end of a later bracket.
+        [&](Lanes& L, int i, float slo, float te) {
+            // No sign change in an empty leaf: past its exit, by the step a sample of value
+            // slo would take (the field is >= slo at the exit, which lies in the leaf), but
+            // at least a quarter pixel, for progress; the current point is the outside end
+            // of a later bracket.
             if (L.sl[i] > 0.0f) return false;  // bisecting
             const float t = L.t[i], tn = std::max(te, t);
             L.a[i] = t;
-            L.t[i] = tn + 0.25f * f_.footprint(L.t0[i] + tn) + 1e-6f * tn;
+            const float beyond = std::min(slo * inv_l, f_.raw_max_step);
+            L.t[i] = tn + std::max(beyond, 0.25f * f_.footprint(L.t0[i] + tn) + 1e-6f * tn);
             return true;
         },
         [](Lanes& L, int i) { L.om[i] = 0.0f, L.t[i] = L.tmax[i]; });
