@@ -216,7 +216,8 @@ void Worker::march(const RaySet& rs) {
 // Marching a raw field (no distance bound): steps of |f| / L, with L a Lipschitz estimate
 // sampled over the volume (make_frame, frame.cpp), clamped to [one pixel footprint, raw_max_step]; a
 // sign change (f <= 0) is refined by bisection to the outside end of the bracket. Thin features
-// (under a pixel or where the estimate is low) can be missed: the price of no bound.
+// (under a pixel or where the estimate is low) can be missed: the price of no bound. An empty
+// tape-tree leaf is left by the same rule, its lower bound standing for the sample.
 // Lane state: a = previous t, b / w = bisection bracket (lo, hi), sl = bisection iterations
 // (0 while marching), om = 1 when the ray ended as a hit.
 // `shadow`: results go to vis_ (0 = blocked) instead of t_ / hit_ / steps_.
