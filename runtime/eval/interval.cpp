@@ -41,7 +41,7 @@ SDFC_IV_INLINE float margin(float x, float rel, float abs) {
 }
 SDFC_IV_INLINE float dn(float x) { return x - margin(x, 0x1p-22f, 0x1p-126f); }
 SDFC_IV_INLINE float up(float x) { return x + margin(x, 0x1p-22f, 0x1p-126f); }
-// Wider, for libm results (a few ulps between implementations).
+// Wider, for the transcendentals (om::exp_ and kin: a few ulps, not proven monotonic).
 SDFC_IV_INLINE float dnw(float x) { return x - margin(x, 0x1p-18f, 0x1p-120f); }
 SDFC_IV_INLINE float upw(float x) { return x + margin(x, 0x1p-18f, 0x1p-120f); }
 
@@ -71,7 +71,7 @@ SDFC_IV_INLINE void mul_iv(float al, float ah, float bl, float bh, float& lo, fl
     hi = mx(mx(p0, p1), mx(p2, p3));
 }
 
-// Monotonic libm function, increasing.
+// Monotonic transcendental, increasing.
 template <class F>
 SDFC_IV_INLINE void mono_inc(F f, float al, float ah, float& lo, float& hi) {
     lo = dnw(f(al));
