@@ -5,8 +5,9 @@
 // and rounds once (add, sub, mul, min, max, sqrt, square, ...), computing the interval's
 // ends with the same float operation as the VM gives bounds that enclose the VM's results
 // exactly, with no outward rounding. Ops whose VM form may round more than once, or may be
-// contracted into an FMA by the compiler (MulAddI, Mix, Length2/3, Mod), and the transcendentals
-// (om::exp_ and the like, not proven monotonic to the ulp) are widened by a few ulps. Min/max choices compare the interval ends with the same comparisons the VM's
+// contracted into an FMA by the compiler (MulAddI, Mix, Length2/3, Mod), and the
+// transcendentals (om::exp_ and the like, not proven monotonic to the ulp) are widened by a
+// few ulps. Min/max choices compare the interval ends with the same comparisons the VM's
 // om::min_ / om::max_ make, so a decided choice is the VM's choice at every point.
 #include "runtime/eval/interval.hpp"
 
@@ -99,9 +100,6 @@ SDFC_IV_INLINE void sin_iv(float l, float h, float peak_at, float (*f)(float), f
     hi = mn(hi, 1.0f);
 }
 
-float sinf_(float x) { return om::sin_(x); }
-float cosf_(float x) { return om::cos_(x); }
-
 // Unknown intervals. Invariant: if a point of the box may give NaN, or the interval is
 // unknown, both ends are NaN; NaN ends never decide a choice (comparisons are false). An
 // op keeps it by adding z (0, or NaN) to both ends, z from its poison kind: opcodes.def's
@@ -151,8 +149,8 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
             hi = std::sqrt(mx(ah, 0.0f));
             z += al < 0.0f ? kNaN : 0.0f;  // some point may take the root of a negative number
             break;
-        case Op::Sin: sin_iv(al, ah, kPi / 2, sinf_, lo, hi); break;
-        case Op::Cos: sin_iv(al, ah, 0.0f, cosf_, lo, hi); break;
+        case Op::Sin: sin_iv(al, ah, kPi / 2, om::sin_, lo, hi); break;
+        case Op::Cos: sin_iv(al, ah, 0.0f, om::cos_, lo, hi); break;
         case Op::Tan: {
             // Monotonic between asymptotes at pi/2 + pi n.
             const double pi = 3.141592653589793;
