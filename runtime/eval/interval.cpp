@@ -111,7 +111,7 @@ constexpr Poison poison_kind() { return kOpInfo[int(O)].poison; }
 // The interval semantics of op O: [al, ah] etc. in, [lo, hi] and the choice out.
 template <Op O>
 SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float ch, float k, float& lo, float& hi,
-                       uint8_t& choice) {
+                       int& choice) {  // (an int, not a byte: lane loops of one element width vectorise best)
     choice = kChoiceBoth;
     constexpr int arity = kOpInfo[int(O)].arity;
     constexpr Poison P = poison_kind<O>();
@@ -216,13 +216,13 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
             // om::min_(a, b) = b < a ? b : a
             lo = mn(al, bl);
             hi = mn(ah, bh);
-            choice = uint8_t((ah <= bl) * kChoiceA + (bh < al) * kChoiceB);  // exclusive
+            choice = int((ah <= bl) * kChoiceA + (bh < al) * kChoiceB);  // exclusive
             break;
         case Op::Max:
             // om::max_(a, b) = a < b ? b : a
             lo = mx(al, bl);
             hi = mx(ah, bh);
-            choice = uint8_t((ah < bl) * kChoiceB + (bh <= al) * kChoiceA);
+            choice = int((ah < bl) * kChoiceB + (bh <= al) * kChoiceA);
             break;
         case Op::Mod: {
             // a - b floor(a / b) lies in [0, b) (b > 0) or (b, 0] (b < 0), up to rounding
@@ -328,13 +328,13 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
             // om::min_(a, k) = k < a ? k : a
             lo = mn(al, k);
             hi = mn(ah, k);
-            choice = uint8_t((ah <= k) * kChoiceA + (k < al) * kChoiceB);
+            choice = int((ah <= k) * kChoiceA + (k < al) * kChoiceB);
             break;
         case Op::MaxI:
             // om::max_(a, k) = a < k ? k : a
             lo = mx(al, k);
             hi = mx(ah, k);
-            choice = uint8_t((ah < k) * kChoiceB + (k <= al) * kChoiceA);
+            choice = int((ah < k) * kChoiceB + (k <= al) * kChoiceA);
             break;
         case Op::ModI: {
             float m = mx(std::fabs(al), std::fabs(ah)) * 0x1p-20f + std::fabs(k) * 0x1p-20f + 0x1p-120f;
@@ -385,7 +385,7 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
             z = (t ? zb : 0.0f) + (f ? zc : 0.0f) + ((t | f) ? 0.0f : zb + zc);
             lo = t ? bl : (f ? cl : mn(bl, cl));
             hi = t ? bh : (f ? ch : mx(bh, ch));
-            choice = uint8_t(t * kChoiceB + f * kChoiceC);
+            choice = int(t * kChoiceB + f * kChoiceC);
             break;
         }
         case Op::Mix: {
@@ -421,21 +421,21 @@ float* alloc_floats(size_t count) {  // uninitialised: a register is written bef
 // (and the same with a and b swapped). The VM's min_/max_ with a NaN operand do not follow
 // these, so both operands must be known (not NaN); an immediate decides alone.
 template <Op O>
-SDFC_IV_INLINE uint8_t sign_choice(uint8_t c, float al, float ah, float bl, float bh, float k) {
+SDFC_IV_INLINE int sign_choice(int c, float al, float ah, float bl, float bh, float k) {
     if constexpr (O == Op::Min || O == Op::Max) {
         const bool known = (al == al) & (ah == ah) & (bl == bl) & (bh == bh);
         const bool neg_a = ah < 0.0f, neg_b = bh < 0.0f, pos_a = al >= 0.0f, pos_b = bl >= 0.0f;
         const bool pick_a = O == Op::Min ? (neg_a | pos_b) : (pos_a | neg_b);
         const bool pick_b = O == Op::Min ? (neg_b | pos_a) : (pos_b | neg_a);
-        const uint8_t s = pick_a ? uint8_t(kChoiceA) : (pick_b ? uint8_t(kChoiceB) : uint8_t(kChoiceBoth));
+        const int s = pick_a ? int(kChoiceA) : (pick_b ? int(kChoiceB) : int(kChoiceBoth));
         return c != kChoiceBoth ? c : (known ? s : c);
     } else if constexpr (O == Op::MinI) {
         // k >= 0: min(a, k) < 0 is a < 0 (also for NaN a); k < 0: always true (not for NaN a).
         const bool known = (al == al) & (ah == ah);
-        return c != kChoiceBoth ? c : (k >= 0.0f ? uint8_t(kChoiceA) : ((k < 0.0f) & known ? uint8_t(kChoiceB) : c));
+        return c != kChoiceBoth ? c : (k >= 0.0f ? int(kChoiceA) : ((k < 0.0f) & known ? int(kChoiceB) : c));
     } else if constexpr (O == Op::MaxI) {
         // k < 0: max(a, k) < 0 is a < 0; k >= 0: never (both also for NaN a).
-        return c != kChoiceBoth ? c : (k < 0.0f ? uint8_t(kChoiceA) : (k >= 0.0f ? uint8_t(kChoiceB) : c));
+        return c != kChoiceBoth ? c : (k < 0.0f ? int(kChoiceA) : (k >= 0.0f ? int(kChoiceB) : c));
     } else {
         return c;
     }
@@ -478,14 +478,14 @@ RunFn kernels() {
 
 Interval eval_interval(Op op, Interval a, Interval b, Interval c, float k, uint8_t* choice) {
     Interval r{};
-    uint8_t ch = kChoiceBoth;
+    int ch = kChoiceBoth;
     switch (op) {
 #define OP(name, mn, ar, imm, choice_, poison_, sem, glsl) \
     case Op::name: iv<Op::name>(a.lo, a.hi, b.lo, b.hi, c.lo, c.hi, k, r.lo, r.hi, ch); break;
 #include "compiler/ir/opcodes.def"
 #undef OP
     }
-    if (choice) *choice = ch;
+    if (choice) *choice = uint8_t(ch);
     return r;
 }
 
@@ -520,7 +520,7 @@ void IntervalEvaluator::eval(const TapeView& t, const float* xlo, const float* x
         for (uint32_t i = 0; i < t.len; ++i) nch += is_choice_op(t.code[i].op);
     }
     reserve(t.num_regs, nch);
-    const int m = (n + 7) / 8 * 8;  // lanes computed (whole vectors); padding copies lane n-1
+    const int m = (n + 15) / 16 * 16;  // lanes computed (whole vectors); padding copies lane n-1
     stride_ = m;
     out_ = t.output(0);
     float* cv = nullptr;

@@ -1,6 +1,17 @@
 // The interval evaluator's kernel: included by interval.cpp once per instruction set, each
 // copy in its own namespace (runtime/eval/isa.hpp); no include guard on purpose.
 
+// Lanes 0 .. m (a multiple of 8) in whole vectors: loops of a constant 16 or 8 lanes,
+// which the compiler turns into straight vector code. A loop of run-time length m left
+// m = 16 to a scalar remainder loop (measured: 16 lanes took longer than 32).
+template <class F>
+SDFC_IV_INLINE void for_lanes(int m, F f) {
+    for (int i0 = 0; i0 < m; i0 += 16) {
+        SDFC_IVDEP
+        for (int i = i0; i < i0 + 16; ++i) f(i);
+    }
+}
+
 // One choice op over m lanes; SignOnly: also decided by sign (sign_choice in interval.cpp).
 // Operands are read before the output is written: it may share their register.
 // Chain: also keeps the operands' intervals (al, ah, bl, bh: 4 rows of m) for
@@ -17,22 +28,28 @@ SDFC_IV_INLINE void choice_op(const Instr& in, float* const L, float* const H, u
     const float* cl = L + size_t(in.c) * kIvLanes;
     const float* chh = H + size_t(in.c) * kIvLanes;
     const float k = in.k;
-    SDFC_IVDEP
-    for (int i = 0; i < m; ++i) {
-        uint8_t c;
-        float lo, hi;
-        iv<O>(al[i], ah[i], bl[i], bh[i], cl[i], chh[i], k, lo, hi, c);
-        if constexpr (SignOnly) c = sign_choice<O>(c, al[i], ah[i], bl[i], bh[i], k);
-        if constexpr (Chain) {
-            cv[i] = al[i];
-            cv[m + i] = ah[i];
-            cv[2 * m + i] = bl[i];
-            cv[3 * m + i] = bh[i];
-            unknown[i] |= uint8_t((al[i] != al[i]) | (ah[i] != ah[i]) | (bl[i] != bl[i]) | (bh[i] != bh[i]));
+    for (int i0 = 0; i0 < m; i0 += 16) {
+        int cw[16], uw[16];  // choices and unknown flags as ints: the float loop stays one width
+        SDFC_IVDEP
+        for (int i = i0; i < i0 + 16; ++i) {
+            int c;
+            float lo, hi;
+            iv<O>(al[i], ah[i], bl[i], bh[i], cl[i], chh[i], k, lo, hi, c);
+            if constexpr (SignOnly) c = sign_choice<O>(c, al[i], ah[i], bl[i], bh[i], k);
+            if constexpr (Chain) {
+                cv[i] = al[i];
+                cv[m + i] = ah[i];
+                cv[2 * m + i] = bl[i];
+                cv[3 * m + i] = bh[i];
+                uw[i - i0] = (al[i] != al[i]) | (ah[i] != ah[i]) | (bl[i] != bl[i]) | (bh[i] != bh[i]);
+            }
+            rl[i] = lo;
+            rh[i] = hi;
+            cw[i - i0] = c;
         }
-        rl[i] = lo;
-        rh[i] = hi;
-        chp[i] = c;
+        for (int i = 0; i < 16; ++i) chp[i0 + i] = uint8_t(cw[i]);
+        if constexpr (Chain)
+            for (int i = 0; i < 16; ++i) unknown[i0 + i] |= uint8_t(uw[i]);
     }
 }
 
@@ -77,14 +94,13 @@ void run(const TapeView& t, float* const L, float* const H, uint8_t* chp, float*
                 chp += m;                                                                   \
                 if (cv) cv += 4 * m;                                                        \
             } else {                                                                        \
-                SDFC_IVDEP                                                                  \
-                for (int i = 0; i < m; ++i) {                                               \
-                    uint8_t c;                                                              \
+                for_lanes(m, [&](int i) SDFC_IV_LAMBDA {                                    \
+                    int c;                                                                  \
                     float lo, hi;                                                           \
                     iv<Op::name>(al[i], ah[i], bl[i], bh[i], cl[i], chh[i], k, lo, hi, c);  \
                     rl[i] = lo;                                                             \
                     rh[i] = hi;                                                             \
-                }                                                                           \
+                });                                                                         \
             }                                                                               \
         }                                                                                   \
         break;

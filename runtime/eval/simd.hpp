@@ -19,3 +19,9 @@
 #else
 #define SDFC_IV_INLINE inline
 #endif
+// The same for a lambda body passed to a lane loop: `[&](int i) SDFC_IV_LAMBDA { ... }`.
+#if defined(__GNUC__)
+#define SDFC_IV_LAMBDA __attribute__((always_inline))
+#else
+#define SDFC_IV_LAMBDA
+#endif

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "compiler/bytecode/compile.hpp"
@@ -197,4 +198,41 @@ TEST_CASE("sign-only min/max (a 2D image's tape) are decided by sign where the o
     Tape u = Tape::from(test::single_op_program(Op::Min, 0));
     u.mark_sign_only();
     CHECK((u.code[3].pad & kSignOnly));
+}
+
+TEST_CASE("the batch interval evaluator gives a box the same bounds and choices at any lane count") {
+    // Lanes run in whole vectors of 16 (runtime/eval/interval_kernel.inl): a box's result must
+    // not depend on how many others share the call, or on where the last vector ends.
+    auto c = test::compile_text(R"(
+        difference() {
+            union() { translate([0.5, 0, 0]) sphere(0.3); translate([-0.5, 0.2, 0]) box([0.2, 0.3, 0.2]); }
+            translate([0, 0.1, 0]) cylinder(0.15, 2);
+        }
+    )");
+    for (bool sign_only : {false, true}) {
+        Tape full = Tape::from(c->cs.distance);
+        if (sign_only) full.mark_sign_only();
+        IntervalEvaluator all(full.num_regs, full.choices), some(full.num_regs, full.choices);
+        std::mt19937 rng(5);
+        std::uniform_real_distribution<float> u(-1.0f, 1.0f), sz(0.01f, 0.8f);
+        float lo[3][kIvLanes], hi[3][kIvLanes];
+        for (int l = 0; l < kIvLanes; ++l)
+            for (int a = 0; a < 3; ++a) lo[a][l] = u(rng), hi[a][l] = lo[a][l] + sz(rng);
+        all.eval(full, lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], kIvLanes);
+        size_t decided = 0;
+        for (int n : {1, 7, 8, 9, 15, 16, 17, 31, 33, 48, 63}) {
+            some.eval(full, lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], n);
+            for (int l = 0; l < n; ++l) {
+                INFO("sign_only " << sign_only << ", n " << n << ", lane " << l);
+                const Interval x = some.result(l), y = all.result(l);
+                CHECK(std::memcmp(&x, &y, sizeof(Interval)) == 0);
+                for (uint32_t s = 0; s < full.choices; ++s) {
+                    const uint8_t a = all.choices()[size_t(s) * size_t(all.stride()) + size_t(l)];
+                    CHECK(some.choices()[size_t(s) * size_t(some.stride()) + size_t(l)] == a);
+                    decided += a != kChoiceBoth;
+                }
+            }
+        }
+        CHECK(decided > 0);
+    }
 }
