@@ -13,7 +13,9 @@
 //   one 64-lane VM batch of its tape (a "trace": the parent's live instructions).
 //   The top levels run their children as oneTBB tasks while their tiles are few for the
 //   threads (Ctx::nested: one level for 2 threads), each task with scratch from a pool
-//   (not per thread: a thread waiting in a nested parallel_for may run another task).
+//   (not per thread: a thread waiting in a nested parallel_for may run another task). Such
+//   a level only finds which parent instructions each child needs (simplify_masks); each
+//   task then makes its own tape (simplify_lane), so the top tile's serial part is short.
 //
 // Exactness: the interval bounds enclose the VM's float results bit for bit, and a
 // simplified tape computes, inside its tile, floats with the same sign (< 0 or not) as its
@@ -64,7 +66,8 @@ struct Scratch {
     uint32_t root_regs, root_choices;
     std::vector<std::unique_ptr<IntervalEvaluator>> iv;  // per depth: the choices stay readable while children run
     std::vector<Tape> tapes;                             // per depth: the tape of the tile being processed
-    std::vector<BatchScratch> batch;                     // per depth: the children's tapes
+    std::vector<BatchScratch> batch;                     // per depth: the children's tapes (or masks)
+    SimplifyScratch lane;                                // simplify_lane of a task's own tile
     uint64_t points = 0;
 };
 
@@ -175,6 +178,11 @@ struct Children {
     bool leaves = false;
     int cx[kIvLanes], cy[kIvLanes], todo[kIvLanes];
     uint64_t inside = 0;
+    // The children run as tasks: each simplifies its own tape (simplify_lane) from the
+    // parent's masks, in parallel, instead of all of them before the tasks start.
+    bool tasks = false;
+    const Tape* parent = nullptr;
+    const IntervalEvaluator* iv = nullptr;
 };
 
 // Evaluates the children of the tile [x0, x0 + size)^2 (clipped to the image) at depth
@@ -223,7 +231,11 @@ void split(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0, Children& ch)
         }
         // else: outside, and the image starts black
     }
-    simplify_batch(t, iv.choices(), iv.stride(), lanes, s.batch[size_t(depth)], /*compact=*/!ch.leaves);
+    ch.tasks = child >= 64 && ch.m > 1 && !ch.leaves && c.nested(depth);
+    ch.parent = &t;
+    ch.iv = &iv;
+    if (ch.tasks) simplify_masks(t, iv.choices(), iv.stride(), lanes, s.batch[size_t(depth)]);
+    else simplify_batch(t, iv.choices(), iv.stride(), lanes, s.batch[size_t(depth)], /*compact=*/!ch.leaves);
 }
 
 void process(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0);
@@ -243,12 +255,12 @@ void descend(Ctx& c, Scratch& s, int depth, const Children& ch) {
         }
         return;
     }
-    if (child >= 64 && ch.m > 1 && c.nested(depth)) {
+    if (ch.tasks) {
         tbb::parallel_for(0, ch.m, [&](int q) {
             const int k = ch.todo[q];
             Scratch* s2 = c.pool->acquire();
             Tape& ct = s2->tapes[size_t(depth) + 1];
-            ct.assign(bs.code(k), bs.len[size_t(k)], bs.out[size_t(k)], bs.regs[size_t(k)]);
+            simplify_lane(*ch.parent, ch.iv->choices(), ch.iv->stride(), bs, k, ct, s2->lane);
             process(c, *s2, depth + 1, ct, ch.cx[k], ch.cy[k]);
             c.pool->release(s2);
         });

@@ -123,35 +123,13 @@ inline uint64_t lanes_equal(const uint8_t* row, uint8_t v) {
 #endif
 }
 
-}  // namespace
-
-void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s,
-                    bool compact) {
+// The lanes (bits of `lanes`) in which each instruction's value is needed: mask[i]. One
+// backward pass over the parent (linked, with an output), following only the winners of
+// decided choices.
+void need_masks(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, std::vector<uint64_t>& mask) {
     const size_t n = parent.code.size();
-    s.len.fill(0);
-    s.out.fill(0);
-    s.cap = n;
-    if (lanes == 0) return;
-    const size_t blocks = size_t(64 - __builtin_clzll(lanes));  // lanes 0 .. the highest one used
-    if (s.buf_size < blocks * n) {
-        s.buf.reset(static_cast<Instr*>(::operator new(sizeof(Instr) * blocks * n)));
-        s.buf_size = blocks * n;
-    }
-    Instr* buf = s.buf.get();
-    if (!parent.linked || parent.out_def == Tape::kNone) {
-        for (uint64_t m = lanes; m; m &= m - 1) {
-            const int j = __builtin_ctzll(m);
-            std::copy(parent.code.begin(), parent.code.end(), buf + size_t(j) * n);
-            s.start[size_t(j)] = 0;
-            s.len[size_t(j)] = uint32_t(n);
-            s.regs[size_t(j)] = parent.num_regs;
-            s.out[size_t(j)] = parent.out;
-        }
-        return;
-    }
-    // Backwards: the lanes in which each instruction's value is needed.
-    if (s.mask.size() < n) s.mask.resize(n);
-    uint64_t* need = s.mask.data();
+    if (mask.size() < n) mask.resize(n);
+    uint64_t* need = mask.data();
     std::fill_n(need, n, uint64_t(0));
     need[parent.out_def] = lanes;
     const Instr* code = parent.code.data();
@@ -176,6 +154,99 @@ void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint
         if (in.op == Op::Min || in.op == Op::Max || in.op == Op::Select) need[l.def[1]] |= m & (cb | both);
         if (in.op == Op::Select) need[l.def[2]] |= m & (cc | both);
     }
+}
+
+// Lane j's compact tape from its live instructions list[0 .. count) (parent indices,
+// ascending), walked backwards: registers re-allocated (linear scan; an op's output may
+// share a dying operand's register, which the lane-wise VM allows); a decided choice op's
+// winner takes over its output register (no instruction), or is copied when it stays
+// needed elsewhere; an immediate that wins becomes a constant. Written backwards, ending
+// just before `end`; returns the instruction count and sets `regs` to the registers used.
+size_t compact_lane(const Tape& parent, const uint8_t* choices, int stride, size_t j, const uint32_t* list, size_t count,
+                    Instr* end, std::vector<uint16_t>& bind_store, std::vector<uint16_t>& free_regs, uint32_t& regs) {
+    constexpr uint16_t kFree = 0xFFFF;
+    const size_t n = parent.code.size();
+    const size_t nregs = std::max<size_t>(parent.num_regs, size_t(parent.out) + 1);
+    if (bind_store.size() < nregs) bind_store.resize(nregs);
+    uint16_t* bind = bind_store.data();
+    std::fill_n(bind, nregs, kFree);
+    const Instr* code = parent.code.data();
+    const Tape::Link* links = parent.links.data();
+    RegPool pool(free_regs, n + 1);
+    Instr* out = end;
+    bind[parent.out] = pool.alloc();
+    for (size_t q = count; q-- > 0;) {
+        const uint32_t i = list[q];
+        const Instr& in = code[i];
+        const uint16_t X = bind[in.out];
+        if (X == kFree) continue;  // (cannot happen: the lane needs every listed value)
+        bind[in.out] = kFree;
+        const uint32_t sl = links[i].slot;
+        const uint8_t ch = sl == Tape::kNone ? uint8_t(kChoiceBoth) : choices[size_t(sl) * size_t(stride) + j];
+        if (ch != kChoiceBoth) {
+            if (ch == kChoiceB && (in.op == Op::MinI || in.op == Op::MaxI)) {
+                Instr c{Op::Const};
+                c.out = X;
+                c.k = in.k;
+                *--out = c;
+                pool.release(X);
+                continue;
+            }
+            const uint16_t w = ch == kChoiceA ? in.a : (ch == kChoiceB ? in.b : in.c);
+            if (bind[w] == kFree) {
+                bind[w] = X;  // the winner's value lives in X: no instruction
+            } else {
+                Instr c{Op::Copy};
+                c.out = X;
+                c.a = bind[w];
+                *--out = c;
+                pool.release(X);
+            }
+            continue;
+        }
+        *--out = emit_backward(pool, in, X, [&](int op) {
+            const uint16_t r = op == 0 ? in.a : (op == 1 ? in.b : in.c);
+            if (bind[r] == kFree) bind[r] = pool.alloc();
+            return bind[r];
+        });
+    }
+    regs = pool.used();
+    return size_t(end - out);
+}
+
+// A parent simplify cannot follow (not linked, or no output) is copied as is.
+bool followable(const Tape& parent) { return parent.linked && parent.out_def != Tape::kNone; }
+
+}  // namespace
+
+void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s,
+                    bool compact) {
+    const size_t n = parent.code.size();
+    s.len.fill(0);
+    s.out.fill(0);
+    s.cap = n;
+    if (lanes == 0) return;
+    const size_t blocks = size_t(64 - __builtin_clzll(lanes));  // lanes 0 .. the highest one used
+    if (s.buf_size < blocks * n) {
+        s.buf.reset(static_cast<Instr*>(::operator new(sizeof(Instr) * blocks * n)));
+        s.buf_size = blocks * n;
+    }
+    Instr* buf = s.buf.get();
+    if (!followable(parent)) {
+        for (uint64_t m = lanes; m; m &= m - 1) {
+            const int j = __builtin_ctzll(m);
+            std::copy(parent.code.begin(), parent.code.end(), buf + size_t(j) * n);
+            s.start[size_t(j)] = 0;
+            s.len[size_t(j)] = uint32_t(n);
+            s.regs[size_t(j)] = parent.num_regs;
+            s.out[size_t(j)] = parent.out;
+        }
+        return;
+    }
+    need_masks(parent, choices, stride, lanes, s.mask);
+    const uint64_t* need = s.mask.data();
+    const Instr* code = parent.code.data();
+    const Tape::Link* links = parent.links.data();
     if (!compact) {
         // Forwards: each lane's instructions in the parent's registers. A decided choice op
         // becomes a copy of the winner into its output register (nothing when the winner is
@@ -234,64 +305,52 @@ void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint
             const size_t j = size_t(__builtin_ctzll(m));
             idx[j * n + cnt[j]++] = uint32_t(i);
         }
-    // Per lane, backwards over its live instructions: registers re-allocated (linear scan;
-    // an op's output may share a dying operand's register, which the lane-wise VM allows);
-    // a decided choice op's winner takes over its output register (no instruction), or is
-    // copied when it stays needed elsewhere; an immediate that wins becomes a constant.
-    constexpr uint16_t kFree = 0xFFFF;
-    const size_t nregs = std::max<size_t>(parent.num_regs, size_t(parent.out) + 1);
-    if (s.bind.size() < nregs) s.bind.resize(nregs);
-    uint16_t* bind = s.bind.data();
     for (uint64_t lm = lanes; lm; lm &= lm - 1) {
         const size_t j = size_t(__builtin_ctzll(lm));
-        std::fill_n(bind, nregs, kFree);
-        RegPool pool(s.free_regs, n + 1);
-        Instr* out = buf + j * n + n;  // written backwards from the end of the lane's block
-        size_t nout = 0;
-        bind[parent.out] = pool.alloc();
-        const uint32_t* list = idx + j * n;
-        for (size_t q = cnt[j]; q-- > 0;) {
-            const uint32_t i = list[q];
-            const Instr& in = code[i];
-            const uint16_t X = bind[in.out];
-            if (X == kFree) continue;  // (cannot happen: the lane needs every listed value)
-            bind[in.out] = kFree;
-            const uint32_t sl = links[i].slot;
-            const uint8_t ch = sl == Tape::kNone ? uint8_t(kChoiceBoth) : choices[size_t(sl) * size_t(stride) + j];
-            if (ch != kChoiceBoth) {
-                if (ch == kChoiceB && (in.op == Op::MinI || in.op == Op::MaxI)) {
-                    Instr c{Op::Const};
-                    c.out = X;
-                    c.k = in.k;
-                    *--out = c;
-                    ++nout;
-                    pool.release(X);
-                    continue;
-                }
-                const uint16_t w = ch == kChoiceA ? in.a : (ch == kChoiceB ? in.b : in.c);
-                if (bind[w] == kFree) {
-                    bind[w] = X;  // the winner's value lives in X: no instruction
-                } else {
-                    Instr c{Op::Copy};
-                    c.out = X;
-                    c.a = bind[w];
-                    *--out = c;
-                    ++nout;
-                    pool.release(X);
-                }
-                continue;
-            }
-            *--out = emit_backward(pool, in, X, [&](int op) {
-                const uint16_t r = op == 0 ? in.a : (op == 1 ? in.b : in.c);
-                if (bind[r] == kFree) bind[r] = pool.alloc();
-                return bind[r];
-            });
-            ++nout;
-        }
+        uint32_t regs = 1;
+        const size_t nout = compact_lane(parent, choices, stride, j, idx + j * n, cnt[j], buf + j * n + n, s.bind,
+                                         s.free_regs, regs);
         s.start[j] = uint32_t(n - nout);
         s.len[j] = uint32_t(nout);
-        s.regs[j] = pool.used();
+        s.regs[j] = regs;
     }
+}
+
+void simplify_masks(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s) {
+    if (lanes != 0 && followable(parent)) need_masks(parent, choices, stride, lanes, s.mask);
+}
+
+void simplify_lane(const Tape& parent, const uint8_t* choices, int stride, const BatchScratch& masks, int lane, Tape& out,
+                   SimplifyScratch& s) {
+    out.linked = false;
+    out.links.clear();
+    out.out_def = Tape::kNone;
+    if (!followable(parent)) {
+        out.code = parent.code;
+        out.out = parent.out;
+        out.num_regs = parent.num_regs;
+        out.choices = parent.choices;
+        out.well_formed = parent.well_formed;
+        return;
+    }
+    const size_t n = parent.code.size();
+    // The lane's live instructions, in order: a branch-free scan of the masks' bit `lane`.
+    if (s.list.size() < n) s.list.resize(n);
+    uint32_t* list = s.list.data();
+    const uint64_t* need = masks.mask.data();
+    size_t count = 0;
+    for (size_t i = 0; i < n; ++i) {
+        list[count] = uint32_t(i);
+        count += (need[i] >> lane) & 1;
+    }
+    if (s.rev.size() < n + 1) s.rev.resize(n + 1);
+    Instr* end = s.rev.data() + n + 1;
+    uint32_t regs = 1;
+    const size_t nout = compact_lane(parent, choices, stride, size_t(lane), list, count, end, s.bind, s.free_regs, regs);
+    out.code.assign(end - nout, end);
+    out.out = 0;  // the output was bound first
+    out.num_regs = regs;
+    out.well_formed = true;
 }
 
 }  // namespace sdfc
