@@ -13,7 +13,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-void check_identical(const std::string& name, int w, int h) {
+// threads: 0 for all cores; more than 4 runs the quadtree's second level as tasks too
+// (Ctx::nested in raster2d.cpp), each making its own tape (simplify_lane).
+void check_identical(const std::string& name, int w, int h, int threads = 0) {
     const fs::path path = fs::path(SDFC_SHARED_DIR) / "bench" / "vm" / name;
     if (!fs::exists(path)) {
         WARN("skipped: " << path << " is absent");
@@ -24,7 +26,7 @@ void check_identical(const std::string& name, int w, int h) {
     CompiledScene cs = compile_scene(s);
     REQUIRE(cs.is_2d);
     RenderStats fast_stats, brute_stats;
-    Image fast = render_2d(cs, w, h, 0, false, &fast_stats);
+    Image fast = render_2d(cs, w, h, threads, false, &fast_stats);
     Image brute = render_2d(cs, w, h, 0, true, &brute_stats);
     REQUIRE(fast.width == w);
     REQUIRE(fast.height == h);
@@ -34,7 +36,7 @@ void check_identical(const std::string& name, int w, int h) {
         differ += fast.pixels[i] != brute.pixels[i];
         white += brute.pixels[i] > 0.5f;
     }
-    INFO(name << " " << w << "x" << h << ": " << differ << " pixels differ, " << white << " white");
+    INFO(name << " " << w << "x" << h << ", threads " << threads << ": " << differ << " pixels differ, " << white << " white");
     REQUIRE(differ == 0);
     REQUIRE(white > 0);
     REQUIRE(fast_stats.distance_points < brute_stats.distance_points);
@@ -42,7 +44,11 @@ void check_identical(const std::string& name, int w, int h) {
 
 }  // namespace
 
-TEST_CASE("render_2d: prospero.vm quadtree image equals brute force") { check_identical("prospero.vm", 1024, 1024); }
+TEST_CASE("render_2d: prospero.vm quadtree image equals brute force") {
+    check_identical("prospero.vm", 1024, 1024);
+    check_identical("prospero.vm", 1024, 1024, 1);
+    check_identical("prospero.vm", 1024, 1024, 8);
+}
 
 TEST_CASE("render_2d: hi.vm and quarter.vm equal brute force, odd sizes too") {
     check_identical("hi.vm", 1024, 1024);
