@@ -530,26 +530,36 @@ int cmd_glsl(Args& a) {
 int cmd_bench(Args& a) {
     Common c = read_common(a);
     auto repeat = a.value("--repeat");
+    auto warmup = a.value("--warmup");
     auto threads = a.value("--threads");
     bool baseline = a.flag("--baseline");
     Overrides ov;
     for (const char* f : kOverrideFlags) ov.emplace_back(f, a.value(f));
     std::string path = one_scene(a, "bench");
     int n = repeat ? Args::to_int("--repeat", *repeat, 1, 100000) : 5;
+    const int warm = warmup ? Args::to_int("--warmup", *warmup, 0, 100000) : 2;
     SourceManager sm;
     CompiledScene cs = build(sm, path, c, 0.0f);
     apply_overrides(cs, ov, c);
     RenderOptions ro;
     if (threads) ro.threads = thread_count(*threads);
     ro.baseline = baseline;
+    // The first renders of a process pay for fresh memory (page faults on the picture and
+    // scratch: twice with glibc, whose first large block is mapped, freed, and then taken
+    // from the heap) and thread start-up: --warmup of them run untimed (as hyperfine's
+    // --warmup), and the very first one's time is printed apart (cold_ms).
     std::vector<double> ms;
     RenderStats stats;
-    for (int i = 0; i < n; ++i) {
+    double cold = 0.0;
+    for (int i = 0; i < warm + n; ++i) {
         RenderStats st;
         auto t0 = std::chrono::steady_clock::now();
         if (cs.is_2d) render_2d(cs, cs.render.width, cs.render.height, ro.threads, baseline, &st);
         else render(cs, ro, &st);
-        ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+        const double t = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        if (i == 0) cold = t;
+        if (i < warm) continue;
+        ms.push_back(t);
         stats = st;
     }
     std::vector<double> sorted = ms;
@@ -560,9 +570,9 @@ int cmd_bench(Args& a) {
     // material (shading program) evaluations.
     auto per = [&](uint64_t v) { return double(v) / pixels; };
     const auto& by = stats.distance_points_by;
-    std::printf("median_ms=%.3f min_ms=%.3f evals_per_pixel=%.2f rays=%.2f normals=%.2f shadows=%.2f ao=%.2f "
+    std::printf("median_ms=%.3f min_ms=%.3f cold_ms=%.3f evals_per_pixel=%.2f rays=%.2f normals=%.2f shadows=%.2f ao=%.2f "
                 "shading=%.2f tape=%.0f/%zu tree_leaves=%llu tree_ms=%.1f skips=%.2f isa=%s\n",
-                median, sorted.front(), per(stats.distance_points), per(by[RenderStats::kRays]),
+                median, sorted.front(), cold, per(stats.distance_points), per(by[RenderStats::kRays]),
                 per(by[RenderStats::kNormals]), per(by[RenderStats::kShadows]), per(by[RenderStats::kAo]),
                 per(stats.shading_points),
                 stats.distance_points ? double(stats.distance_instructions) / double(stats.distance_points) : 0.0,

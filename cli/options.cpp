@@ -154,11 +154,12 @@ std::vector<CommandSpec> make_commands() {
     c.push_back({"bench", "SCENE", "time renders of the scene",
                  with({
                           {"--repeat", "", "N", "", "5", "renders timed"},
+                          {"--warmup", "", "N", "", "2", "untimed renders first (their one-time costs: fresh memory, thread start-up)"},
                           threads,
                           baseline,
                       },
                       render_settings()),
-                 "Prints median_ms, min_ms, evals_per_pixel (SDF evaluations: rays, normals, shadows, ao), shading (material "
+                 "Prints median_ms, min_ms (of the timed renders), cold_ms (the process's first render), evals_per_pixel (SDF evaluations: rays, normals, shadows, ao), shading (material "
                  "evaluations), the mean program length run (tape=MEAN/FULL), the tape tree and the kernels' instruction set (isa).",
                  true});
     c.push_back({"watch", "[--runs N] [--debounce MS] CMD ARGS...", "run a command again on every save of its scene or an import",

@@ -206,3 +206,18 @@ TEST_CASE("bench prints one line of times and evaluations, --baseline evaluates 
     REQUIRE(s4.status == 0);
     CHECK(field(s4.out, "rays") > 3.0 * field(fast.out, "rays"));
 }
+
+TEST_CASE("bench --warmup: untimed renders first; the first render's time apart as cold_ms") {
+    const std::string scene = test::example("three-tori.sdf");
+    auto none = run_sdfc("bench '" + scene + "' --width 32 --height 18 --repeat 1 --warmup 0");
+    REQUIRE(none.status == 0);
+    INFO(none.out);
+    // Without warm-up the one timed render is the first: its time is the cold one.
+    CHECK(field(none.out, "cold_ms") == field(none.out, "median_ms"));
+    auto some = run_sdfc("bench '" + scene + "' --width 32 --height 18 --repeat 1 --warmup 3");
+    REQUIRE(some.status == 0);
+    CHECK(field(some.out, "cold_ms") > 0.0);
+    auto bad = run_sdfc("bench '" + scene + "' --warmup -1");
+    CHECK(bad.status == 2);
+    CHECK(bad.err.find("--warmup must be from 0 to 100000, not -1") != std::string::npos);
+}
