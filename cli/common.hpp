@@ -1,9 +1,11 @@
 // What the commands share: the safety-limit flags, the one-scene argument, building a
-// scene, thread counts and the progress bar line. cli/main.cpp holds most commands,
-// cli/mesh_command.cpp the mesh command.
+// scene, the camera and render flags, thread counts and the progress bar line. cli/main.cpp
+// holds most commands; mesh, bench, preview and watch have files of their own.
 #pragma once
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "cli/args.hpp"
 #include "compiler/base/source.hpp"
@@ -51,7 +53,17 @@ Shard read_shard(const std::optional<std::string>& flag, size_t items);
 std::optional<std::pair<int, int>> read_bands(const std::optional<std::string>& flag);
 int cmd_merge(Args& a);
 
+// The scene flags a command took out of its arguments (flag, value if given): they override
+// the script's settings of each scene it compiles (render and bench).
+using Overrides = std::vector<std::pair<std::string, std::optional<std::string>>>;
+// The camera and render(...) flags (--width, --samples, --camera-position, ...), taken out.
+Overrides read_overrides(Args& a);
+// Sets them on a compiled scene; the picture's size checked against --max-pixels.
+void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c);
+
 int cmd_mesh(Args& a);
+// `sdfc bench` (bench_command.cpp): renders timed, one line of figures.
+int cmd_bench(Args& a);
 // `sdfc preview` (preview_command.cpp): serves the live page until Ctrl-C.
 int cmd_preview(Args& a);
 // `sdfc watch` (watch_command.cpp): `run` runs one command line, its errors reported.

@@ -1,5 +1,5 @@
 // sdfc: the command line. Each subcommand is a short function over the library stages (the
-// mesh command is in mesh_command.cpp, what they share in common.hpp);
+// mesh, bench, preview and watch commands are in their own files, what they share in common.hpp);
 // every user error ends as `path:line:col: error:` (scripts, exit 1) or `sdfc: error:` (exit 2 for the
 // command line, 1 for anything else).
 #include <unistd.h>
@@ -76,9 +76,6 @@ std::string expand(std::string out, int frame, const std::string& name) {
     return out;
 }
 
-// The scene flags a command took out of its arguments (flag, value if given): they override
-// the script's settings of each scene it compiles.
-using Overrides = std::vector<std::pair<std::string, std::optional<std::string>>>;
 // The flags that override the script's camera and render(...) settings (render and bench).
 constexpr const char* kOverrideFlags[] = {"--width",     "--height",  "--samples", "--camera-position", "--camera-target", "--fov",
                                           "--max-steps", "--max-bounces", "--max-distance", "--epsilon", "--shadows", "--ao", "--aa",
@@ -137,6 +134,8 @@ bool apply_render_flags(RenderSettings& r, Args& a) {
     return sized;
 }
 
+}  // namespace
+
 void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
     Args a = flat_args(ov);
     const bool sized = apply_render_flags(cs.render, a);  // the size comes from flags, not (only) from the script
@@ -168,6 +167,14 @@ void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
     }
 }
 
+Overrides read_overrides(Args& a) {
+    Overrides ov;
+    for (const char* f : kOverrideFlags) ov.emplace_back(f, a.value(f));
+    return ov;
+}
+
+namespace {
+
 int cmd_render(Args& a) {
     Common c = read_common(a);
     auto out = a.value("-o", "--output");
@@ -185,8 +192,7 @@ int cmd_render(Args& a) {
     auto tiles = a.value("--tiles");
     const bool skip_existing = a.flag("--skip-existing");
     // Overrides are read per scene below; take them out of the positionals first.
-    Overrides ov;
-    for (const char* f : kOverrideFlags) ov.emplace_back(f, a.value(f));
+    Overrides ov = read_overrides(a);
     auto scenes = a.positionals();
     if (scenes.empty()) throw UsageError("render needs a scene file");
     if (!out) throw UsageError("render needs -o OUT");
@@ -524,59 +530,6 @@ int cmd_glsl(Args& a) {
         return 0;
     }
     write_text_file(*out, text);
-    return 0;
-}
-
-int cmd_bench(Args& a) {
-    Common c = read_common(a);
-    auto repeat = a.value("--repeat");
-    auto warmup = a.value("--warmup");
-    auto threads = a.value("--threads");
-    bool baseline = a.flag("--baseline");
-    Overrides ov;
-    for (const char* f : kOverrideFlags) ov.emplace_back(f, a.value(f));
-    std::string path = one_scene(a, "bench");
-    int n = repeat ? Args::to_int("--repeat", *repeat, 1, 100000) : 5;
-    const int warm = warmup ? Args::to_int("--warmup", *warmup, 0, 100000) : 2;
-    SourceManager sm;
-    CompiledScene cs = build(sm, path, c, 0.0f);
-    apply_overrides(cs, ov, c);
-    RenderOptions ro;
-    if (threads) ro.threads = thread_count(*threads);
-    ro.baseline = baseline;
-    // The first renders of a process pay for fresh memory (page faults on the picture and
-    // scratch: twice with glibc, whose first large block is mapped, freed, and then taken
-    // from the heap) and thread start-up: --warmup of them run untimed (as hyperfine's
-    // --warmup), and the very first one's time is printed apart (cold_ms).
-    std::vector<double> ms;
-    RenderStats stats;
-    double cold = 0.0;
-    for (int i = 0; i < warm + n; ++i) {
-        RenderStats st;
-        auto t0 = std::chrono::steady_clock::now();
-        if (cs.is_2d) render_2d(cs, cs.render.width, cs.render.height, ro.threads, baseline, &st);
-        else render(cs, ro, &st);
-        const double t = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-        if (i == 0) cold = t;
-        if (i < warm) continue;
-        ms.push_back(t);
-        stats = st;
-    }
-    std::vector<double> sorted = ms;
-    std::sort(sorted.begin(), sorted.end());
-    double median = sorted.size() % 2 ? sorted[sorted.size() / 2] : 0.5 * (sorted[sorted.size() / 2 - 1] + sorted[sorted.size() / 2]);
-    double pixels = double(cs.render.width) * cs.render.height;
-    // SDF evaluations (the distance program) per pixel, then what they were for, and the
-    // material (shading program) evaluations.
-    auto per = [&](uint64_t v) { return double(v) / pixels; };
-    const auto& by = stats.distance_points_by;
-    std::printf("median_ms=%.3f min_ms=%.3f cold_ms=%.3f evals_per_pixel=%.2f rays=%.2f normals=%.2f shadows=%.2f ao=%.2f "
-                "shading=%.2f tape=%.0f/%zu tree_leaves=%llu tree_ms=%.1f skips=%.2f isa=%s\n",
-                median, sorted.front(), cold, per(stats.distance_points), per(by[RenderStats::kRays]),
-                per(by[RenderStats::kNormals]), per(by[RenderStats::kShadows]), per(by[RenderStats::kAo]),
-                per(stats.shading_points),
-                stats.distance_points ? double(stats.distance_instructions) / double(stats.distance_points) : 0.0,
-                cs.distance.code.size(), static_cast<unsigned long long>(stats.tree_leaves), stats.tree_ms, per(stats.skips), isa_name(current_isa()));
     return 0;
 }
 

@@ -207,7 +207,7 @@ TEST_CASE("bench prints one line of times and evaluations, --baseline evaluates 
     CHECK(field(s4.out, "rays") > 3.0 * field(fast.out, "rays"));
 }
 
-TEST_CASE("bench --warmup: untimed renders first; the first render's time apart as cold_ms") {
+TEST_CASE("bench --warmup: untimed renders first, the first render's time apart as cold_ms") {
     const std::string scene = test::example("three-tori.sdf");
     auto none = run_sdfc("bench '" + scene + "' --width 32 --height 18 --repeat 1 --warmup 0");
     REQUIRE(none.status == 0);
