@@ -24,6 +24,7 @@ void sdf_clip_ray(vec3 o, vec3 d, inout float t_min, inout float t_max) {
 // sdf_trace marches it (SDF_ST_PRE) once per pixel, the first time sdf_start < 0.
 vec3 sdf_pre_o, sdf_pre_d;
 vec2 sdf_pre_r;  // the cone around the tile's rays: r0 + r1 t
+float sdf_pre_t0;  // where the pre-march begins (sdf_premarch_begin)
 float sdf_start;
 
 void sdf_setup_premarch(float x, float row, vec2 res) {
@@ -31,5 +32,6 @@ void sdf_setup_premarch(float x, float row, vec2 res) {
     float x0 = floor(x / tile) * tile, y0 = floor(row / tile) * tile;
     float x1 = min(x0 + tile, res.x), y1 = min(y0 + tile, res.y);
     sdf_tile_cone(sdf_cam, x0, y0, x1, y1, sdf_pre_o, sdf_pre_d, sdf_pre_r);
+    sdf_pre_t0 = SDF_CLIP && SDF_NUM_PLANES == 0 ? sdf_premarch_begin(SDF_LO, SDF_HI, sdf_pre_o, sdf_pre_d, sdf_pre_r, SDF_MAX_DIST) : 0.0;
     sdf_start = -1.0;
 }

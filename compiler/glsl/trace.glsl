@@ -88,7 +88,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
         }
     } else if (SDF_PREMARCH && sdf_start < 0.0) {
         mode = SDF_ST_PRE;  // then this ray, from where the pre-march ends
-        t = 0.0;
+        t = sdf_pre_t0;
     } else {
         stack[sp++] = r;
     }

@@ -465,6 +465,25 @@ SDF_FN void sdf_tile_cone(SdfCamera c, float x0, float y0, float x1, float y1, S
     }
     r = vec2(r0 * 1.01f + 1e-6f, r1 * 1.01f + 1e-6f);  // rounding margin
 }
+// Where the pre-march begins when rays are clipped to the box [lo, hi] (a bounded scene
+// without floor planes): no ray of the tile is in the box before it, for the axis point is
+// then farther from the box than the cone's radius. Where the cone meets the box, the axis
+// is in the box grown by the largest radius, within [a, b], so the radius is at most
+// r0 + r1 b there: the axis's entry into the box grown by that, less a rounding margin, is
+// early enough. max_dist when the cone misses the box. (Before, the march began at the
+// camera and spent its first steps far from everything, where a big union's guards skip
+// least: 3,300 instructions a step on a 10,000-sphere grid.)
+SDF_FN float sdf_premarch_begin(vec3 lo, vec3 hi, vec3 o, vec3 d, vec2 r, float max_dist) {
+    float g = r.x + r.y * max_dist;
+    float a = 0.0f, b = max_dist;
+    sdf_clip_box(lo - vec3(g), hi + vec3(g), o, d, a, b);
+    if (!(a <= b)) return max_dist;
+    g = r.x + r.y * b;
+    float a2 = 0.0f, b2 = max_dist;
+    sdf_clip_box(lo - vec3(g), hi + vec3(g), o, d, a2, b2);
+    if (!(a2 <= b2)) return max_dist;
+    return max(a2 - 1e-3f * (1.0f + a2), 0.0f);
+}
 // One step of the pre-march at t with distance dist; false when it ends (at most 32 steps,
 // and never past max_dist).
 SDF_FN bool sdf_premarch_step(float dist, vec2 r, float eps, SDF_INOUT(float) t) {

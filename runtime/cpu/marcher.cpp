@@ -406,7 +406,7 @@ float Worker::tile_start(int x0, int y0, int x1, int y1) {
     glm::vec2 r;
     rules::sdf_tile_cone(f_.camera.rule_camera(), static_cast<float>(x0), static_cast<float>(y0), static_cast<float>(x1),
                          static_cast<float>(y1), o, d, r);
-    float t = 0.0f;
+    float t = f_.clip && f_.planes.empty() ? rules::sdf_premarch_begin(f_.lo, f_.hi, o, d, r, f_.max_dist) : 0.0f;
     for (int i = 0; i < 32 && t < f_.max_dist; ++i) {
         const glm::vec3 p = o + d * t;
         float dist;
