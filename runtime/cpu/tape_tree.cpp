@@ -89,6 +89,7 @@ struct TreeScratch {
     std::unique_ptr<IntervalEvaluator> iv;
     uint32_t regs = 0, choices = 0;
     BatchScratch bs;
+    std::vector<Tape::Link> links;  // lent to the cell being split
     uint64_t boxes = 0;
     std::unique_ptr<BatchVM> vm;  // grows to the longest tape it runs
     IntervalEvaluator& get(uint32_t r, uint32_t c) {
@@ -215,7 +216,10 @@ void TreeBuilder::split(TreeScratch& s, uint32_t i) {
             bx[2 * a][k] = !split ? c.lo[a] : (upper ? mid[a] : c.lo[a]);
             bx[2 * a + 1][k] = !split ? c.hi[a] : (upper ? c.hi[a] : mid[a]);
         }
-    if (!c.tape.linked) c.tape.link();
+    if (!c.tape.linked) {
+        c.tape.links.swap(s.links);  // the thread's links array, grown once (see the end)
+        c.tape.link();
+    }
     IntervalEvaluator& iv = s.get(c.tape.num_regs, c.tape.choices);
     iv.eval(c.tape, bx[0], bx[1], bx[2], bx[3], bx[4], bx[5], 8, time_);
     iv.prune_min_chains(c.tape, 8);
@@ -271,13 +275,25 @@ void TreeBuilder::split(TreeScratch& s, uint32_t i) {
     const bool useless = nsimp > 0 && sum * 10 >= c.tape.code.size() * nsimp * 9;
     for (int k = 0; k < 8; ++k) cells_[first + static_cast<uint32_t>(k)].stall = useless ? c.stall + 1 : 0;
     keep_[i] = kept;
+    // The links are not needed again: back to the thread (a fresh array per split cost a
+    // page fault every 256 instructions, about 5 us each on this VM).
+    s.links.swap(c.tape.links);
+    c.tape.links.clear();
+    c.tape.linked = false;
     if (!kept) c.tape = Tape{};  // no longer needed: free it now
 }
 
 void TreeBuilder::emit(TapeTree& T) {
     T.nodes.resize(cells_.size());
     T.boxes_.resize(cells_.size());
-    std::vector<TapeTree::Leaf> kept_at(cells_.size());
+    // The tapes of split cells that settled children run: (code, len, out) by cell.
+    struct Kept {
+        const Instr* code = nullptr;
+        uint32_t len = 0;
+        uint16_t out = 0;
+    };
+    std::vector<Kept> kept;
+    std::vector<uint32_t> kept_of(cells_.size(), kNone);
     T.tapes.reserve(cells_.size() + 1);  // (moves only: the leaves' code pointers stay valid)
     for (size_t i = 0; i < cells_.size(); ++i) {
         TreeCell& c = cells_[i];
@@ -294,10 +310,10 @@ void TreeBuilder::emit(TapeTree& T) {
             node.child = first_child_[i];
             for (uint32_t k = 0; k < 8; ++k) T.boxes_[first_child_[i] + k].parent = static_cast<uint32_t>(i);
             if (keep_[i]) {
-                kept_at[i].len = static_cast<uint32_t>(c.tape.code.size());
-                kept_at[i].out = c.tape.out;
+                kept_of[i] = static_cast<uint32_t>(kept.size());
+                kept.push_back(Kept{nullptr, static_cast<uint32_t>(c.tape.code.size()), c.tape.out});
                 T.tapes.push_back(std::move(c.tape.code));
-                kept_at[i].code = T.tapes.back().data();
+                kept.back().code = T.tapes.back().data();
                 T.max_regs = std::max(T.max_regs, c.tape.num_regs);
             }
             continue;
@@ -307,7 +323,7 @@ void TreeBuilder::emit(TapeTree& T) {
         L.ivlo = c.ivlo, L.ivhi = c.ivhi;
         L.node = static_cast<uint32_t>(i);
         if (c.ref_cell != kNone) {
-            const TapeTree::Leaf& k = kept_at[c.ref_cell];
+            const Kept& k = kept[kept_of[c.ref_cell]];
             L.code = k.code, L.len = k.len, L.out = k.out;
         } else {
             L.len = static_cast<uint32_t>(c.tape.code.size());
