@@ -146,6 +146,19 @@ TEST_CASE("accel: the examples match the baseline", "[accel][examples]") {
     }
 }
 
+TEST_CASE("accel: 3,600 floating spheres match the baseline, their tree capped at a node per 16 samples", "[accel]") {
+    // No floor: rays are clipped to the grid's box and each tile's pre-march begins where
+    // its cone reaches it (rules.h sdf_premarch_begin).
+    auto c = test::compile_text(grid_scene(60, 160, 90, false));
+    const Pair p = render_both(c->cs);
+    INFO("psnr " << psnr(p.accel, p.base) << " leaves " << p.sa.tree_leaves);
+    CHECK(psnr(p.accel, p.base) >= 45.0);
+    // 14,400 samples: the floor of 4,096 nodes holds (without the cap: many more leaves).
+    CHECK(p.sa.tree_leaves > 1000);
+    CHECK(p.sa.tree_leaves <= 4096);
+    CHECK(p.sa.distance_instructions * 4 <= p.sb.distance_instructions);
+}
+
 TEST_CASE("accel: identical pixels for any thread count, with the tree", "[accel][determinism]") {
     auto c = test::compile_text(grid_scene(9, 96, 64));
     RenderOptions ro;

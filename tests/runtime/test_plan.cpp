@@ -151,3 +151,28 @@ TEST_CASE("rules: relaxed steps, hits and the raw-field bisection") {
     CHECK(rules::sdf_grid_x(4, 5) == 1.0f);
     CHECK(rules::sdf_grid_y(0, 5) == 1.0f);
 }
+
+TEST_CASE("rules: the tile pre-march begins no later than its cone first meets the box") {
+    const glm::vec3 lo(-1.0f), hi(1.0f);
+    // Distance from the point to the box (0 inside).
+    auto box_dist = [&](glm::vec3 p) { return glm::length(glm::max(glm::max(lo - p, p - hi), glm::vec3(0.0f))); };
+    const float far = 100.0f;
+    // From inside the box: at once.
+    CHECK(rules::sdf_premarch_begin(lo, hi, glm::vec3(0.5f), glm::vec3(0, 0, -1), glm::vec2(0.1f, 0.01f), far) == 0.0f);
+    // Axis at the box: near the entry (t = 9 less the radius), never after the cone touches it.
+    struct Case {
+        glm::vec3 o;
+        glm::vec2 r;
+        float touch;  // where the cone (o + t (0, 0, -1), radius r0 + r1 t) first meets the box
+    };
+    for (const Case& c : {Case{{0, 0, 10}, {0.1f, 0.01f}, 9.0f - 0.19f / 1.01f}, Case{{0, 1.5f, 10}, {0.6f, 0.0f}, 9.0f - std::sqrt(0.36f - 0.25f)},
+                          Case{{0, 1.5f, 10}, {0.3f, 0.03f}, 0.0f}}) {
+        const float t = rules::sdf_premarch_begin(lo, hi, c.o, glm::vec3(0, 0, -1), c.r, far);
+        INFO("o.y " << c.o.y << " begin " << t);
+        REQUIRE(t < far);
+        for (float s = 0.0f; s <= t; s += 0.01f) CHECK(box_dist(c.o + s * glm::vec3(0, 0, -1)) > c.r.x + c.r.y * s);
+        if (c.touch > 0.0f) CHECK(t > c.touch - 0.5f);  // and not much earlier
+    }
+    // A cone that misses the box: the max distance, nothing to march.
+    CHECK(rules::sdf_premarch_begin(lo, hi, glm::vec3(0, 1.5f, 10), glm::vec3(0, 0, -1), glm::vec2(0.4f, 0.0f), far) == far);
+}
