@@ -118,26 +118,35 @@ void Worker::run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish
             L.z[i] = L.oz[i] + L.t[i] * L.dz[i];
         }
         if (tree) {
-            const int nc = locate_lanes(L, n);
+            // Lanes in leaves empty for them jump, all lanes one jump at a time (each lane's
+            // jumps depend on each other: the lanes' tree walks overlap instead of waiting).
+            int nc = locate_lanes(L, n);
             bool any_out = false;
-            for (int j = 0; j < nc; ++j) {
-                const int i = L.idx[j];
-                float slo = L.sign[i] > 0.0f ? L.ivlo[i] : -L.ivhi[i];
-                for (int it = 0; slo > 0.0f && it < 64; ++it) {
-                    if (!skip(L, i, slo, std::min(L.exit_t(i), L.tmax[i]))) break;
+            for (int it = 0; nc > 0 && it < 64; ++it) {
+                int moved = 0;
+                for (int j = 0; j < nc; ++j) {
+                    const int i = L.idx[j];
+                    const float slo = L.sign[i] > 0.0f ? L.ivlo[i] : -L.ivhi[i];
+                    if (!skip(L, i, slo, std::min(L.exit_t(i), L.tmax[i]))) continue;
                     ++stats.skips;
                     if (!(L.t[i] <= L.tmax[i])) {
                         out(L, i);
                         L.done[i] = 1;
                         any_out = true;
-                        break;
+                        continue;
                     }
                     L.x[i] = L.ox[i] + L.t[i] * L.dx[i];
                     L.y[i] = L.oy[i] + L.t[i] * L.dy[i];
                     L.z[i] = L.oz[i] + L.t[i] * L.dz[i];
+                    L.idx[moved++] = i;
+                }
+                nc = 0;
+                for (int j = 0; j < moved; ++j) {
+                    const int i = L.idx[j];
                     const uint32_t id = T_.locate_from(L.leaf[i], L.x[i], L.y[i], L.z[i]);
                     L.set_leaf(i, id, T_.leaves[id]);
-                    slo = L.sign[i] > 0.0f ? L.ivlo[i] : -L.ivhi[i];
+                    L.idx[nc] = i;
+                    nc += (L.sign[i] > 0.0f ? L.ivlo[i] : -L.ivhi[i]) > 0.0f;
                 }
             }
             if (any_out) {

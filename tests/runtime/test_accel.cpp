@@ -159,6 +159,26 @@ TEST_CASE("accel: 3,600 floating spheres match the baseline, their tree capped a
     CHECK(p.sa.distance_instructions * 4 <= p.sb.distance_instructions);
 }
 
+TEST_CASE("accel: a raw field's tree splits cells however short their tapes, and its rays jump more", "[accel]") {
+    // The same floating spheres marched as a raw field (as a .vm model is: no distance
+    // bound, sign-change steps) and as a distance: the raw field's cells go on splitting
+    // below the 64-instruction tapes where a distance's stop, so more of its marches'
+    // small steps become jumps over empty cells.
+    auto c = test::compile_text(grid_scene(12, 160, 90, false));
+    const Pair d = render_both(c->cs);
+    c->cs.raw_field = true;
+    const Pair r = render_both(c->cs);
+    const double tape_d = double(d.sa.distance_instructions) / double(d.sa.distance_points);
+    const double tape_r = double(r.sa.distance_instructions) / double(r.sa.distance_points);
+    INFO("leaves " << d.sa.tree_leaves << " / " << r.sa.tree_leaves << ", tape " << tape_d << " / " << tape_r << ", skips "
+                   << d.sa.skips << " / " << r.sa.skips << ", points " << r.sa.distance_points << " / " << r.sb.distance_points
+                   << ", psnr " << psnr(r.accel, r.base));
+    CHECK(r.sa.tree_leaves > 2 * d.sa.tree_leaves);
+    CHECK(tape_r < 0.5 * tape_d);
+    CHECK(r.sa.distance_points < r.sb.distance_points);
+    CHECK(psnr(r.accel, r.base) >= 40.0);
+}
+
 TEST_CASE("accel: identical pixels for any thread count, with the tree", "[accel][determinism]") {
     auto c = test::compile_text(grid_scene(9, 96, 64));
     RenderOptions ro;
