@@ -60,6 +60,13 @@ struct Lanes {
         for (int k = 0; k < 3; ++k) blo[k][i] = L.lo[k], bhi[k][i] = L.hi[k];
         ivlo[i] = L.ivlo, ivhi[i] = L.ivhi;
     }
+    // The lane's leaf found again from its point (the leaf's neighbours first).
+    void relocate(int i, const TapeTree& T) {
+        const uint32_t id = T.locate_from(leaf[i], x[i], y[i], z[i]);
+        set_leaf(i, id, T.leaves[id]);
+    }
+    // Lower bound of sign * d over the lane's leaf: > 0 when the leaf is empty for the lane.
+    float slo(int i) const { return sign[i] > 0.0f ? ivlo[i] : -ivhi[i]; }
     void move(int from, int to) {
         ox[to] = ox[from], oy[to] = oy[from], oz[to] = oz[from];
         dx[to] = dx[from], dy[to] = dy[from], dz[to] = dz[from];

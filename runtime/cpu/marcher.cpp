@@ -54,12 +54,8 @@ inline int Worker::locate_lanes(Lanes& L, int n) {
         L.idx[m] = i;
         m += out[i];
     }
-    for (int j = 0; j < m; ++j) {
-        const int i = L.idx[j];
-        const uint32_t id = T_.locate_from(L.leaf[i], L.x[i], L.y[i], L.z[i]);
-        L.set_leaf(i, id, T_.leaves[id]);
-    }
-    for (int i = 0; i < n; ++i) out[i] = (L.sign[i] > 0.0f ? L.ivlo[i] : -L.ivhi[i]) > 0.0f;
+    for (int j = 0; j < m; ++j) L.relocate(L.idx[j], T_);
+    for (int i = 0; i < n; ++i) out[i] = L.slo(i) > 0.0f;
     m = 0;
     for (int i = 0; i < n; ++i) {
         L.idx[m] = i;
@@ -126,8 +122,7 @@ void Worker::run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish
                 int moved = 0;
                 for (int j = 0; j < nc; ++j) {
                     const int i = L.idx[j];
-                    const float slo = L.sign[i] > 0.0f ? L.ivlo[i] : -L.ivhi[i];
-                    if (!skip(L, i, slo, std::min(L.exit_t(i), L.tmax[i]))) continue;
+                    if (!skip(L, i, L.slo(i), std::min(L.exit_t(i), L.tmax[i]))) continue;
                     ++stats.skips;
                     if (!(L.t[i] <= L.tmax[i])) {
                         out(L, i);
@@ -143,10 +138,9 @@ void Worker::run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish
                 nc = 0;
                 for (int j = 0; j < moved; ++j) {
                     const int i = L.idx[j];
-                    const uint32_t id = T_.locate_from(L.leaf[i], L.x[i], L.y[i], L.z[i]);
-                    L.set_leaf(i, id, T_.leaves[id]);
+                    L.relocate(i, T_);
                     L.idx[nc] = i;
-                    nc += (L.sign[i] > 0.0f ? L.ivlo[i] : -L.ivhi[i]) > 0.0f;
+                    nc += L.slo(i) > 0.0f;
                 }
             }
             if (any_out) {
