@@ -60,10 +60,26 @@ struct Lanes {
         for (int k = 0; k < 3; ++k) blo[k][i] = L.lo[k], bhi[k][i] = L.hi[k];
         ivlo[i] = L.ivlo, ivhi[i] = L.ivhi;
     }
-    // The lane's leaf found again from its point (the leaf's neighbours first).
-    void relocate(int i, const TapeTree& T) {
-        const uint32_t id = T.locate_from(leaf[i], x[i], y[i], z[i]);
-        set_leaf(i, id, T.leaves[id]);
+    // The leaves of lanes idx[0, m) found again from their points (each from its leaf's
+    // neighbour across the face its point is beyond). In passes over all the lanes, so that
+    // their loads of tree nodes and leaves overlap instead of waiting one after another.
+    void relocate(const int* idx, int m, const TapeTree& T) {
+        alignas(64) uint32_t n[kWindow];
+        for (int j = 0; j < m; ++j) {
+            const int i = idx[j];
+            const float lo[3] = {blo[0][i], blo[1][i], blo[2][i]}, hi[3] = {bhi[0][i], bhi[1][i], bhi[2][i]};
+            n[j] = T.rope(leaf[i], TapeTree::face_beyond(lo, hi, x[i], y[i], z[i]));
+        }
+        for (int j = 0; j < m; ++j) {
+            __builtin_prefetch(&T.boxes_[n[j]]);
+            __builtin_prefetch(&T.nodes[n[j]]);
+        }
+        for (int j = 0; j < m; ++j) {
+            const int i = idx[j];
+            n[j] = T.find_from(n[j], x[i], y[i], z[i]);
+        }
+        for (int j = 0; j < m; ++j) __builtin_prefetch(&T.leaves[n[j]]);
+        for (int j = 0; j < m; ++j) set_leaf(idx[j], n[j], T.leaves[n[j]]);
     }
     // Lower bound of sign * d over the lane's leaf: > 0 when the leaf is empty for the lane.
     float slo(int i) const { return sign[i] > 0.0f ? ivlo[i] : -ivhi[i]; }

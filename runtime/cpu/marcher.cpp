@@ -54,7 +54,7 @@ inline int Worker::locate_lanes(Lanes& L, int n) {
         L.idx[m] = i;
         m += out[i];
     }
-    for (int j = 0; j < m; ++j) L.relocate(L.idx[j], T_);
+    L.relocate(L.idx, m, T_);
     for (int i = 0; i < n; ++i) out[i] = L.slo(i) > 0.0f;
     m = 0;
     for (int i = 0; i < n; ++i) {
@@ -135,10 +135,10 @@ void Worker::run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish
                     L.z[i] = L.oz[i] + L.t[i] * L.dz[i];
                     L.idx[moved++] = i;
                 }
+                L.relocate(L.idx, moved, T_);
                 nc = 0;
                 for (int j = 0; j < moved; ++j) {
                     const int i = L.idx[j];
-                    L.relocate(i, T_);
                     L.idx[nc] = i;
                     nc += L.slo(i) > 0.0f;
                 }

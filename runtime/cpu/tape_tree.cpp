@@ -197,6 +197,7 @@ private:
         queue_.emplace(prio, ~i);
     }
     void split(TreeScratch& s, uint32_t i);
+    void make_ropes(TapeTree& T) const;
 
     const Program& p_;
     const float time_;
@@ -348,6 +349,44 @@ void TreeBuilder::emit(TapeTree& T) {
         node.child = TapeTree::kLeafBit | static_cast<uint32_t>(T.leaves.size());
         T.leaves.push_back(L);
     }
+    make_ropes(T);
+}
+
+// Top down (parents precede children): a child's neighbour across a face inside its parent
+// is its sibling; across one of the parent's faces, it is the parent's neighbour, or that
+// neighbour's child facing it when the neighbour is as small as the parent and split (cells
+// of one depth have the same extents, hence the same split axes, and share face
+// coordinates bit for bit: both come from their common ancestor's split).
+void TreeBuilder::make_ropes(TapeTree& T) const {
+    constexpr int R = TapeTree::kRopeRow;
+    std::vector<uint32_t> ropes(cells_.size() * R, 0);  // by node
+    for (size_t i = 0; i < cells_.size(); ++i) {
+        const uint32_t first = first_child_[i];
+        if (first == kNone) continue;
+        const TreeCell& c = cells_[i];
+        for (uint32_t k = 0; k < 8; ++k) {
+            const uint32_t ch = first + k;
+            uint32_t* row = &ropes[size_t(ch) * R];
+            row[6] = ch;
+            if (cells_[ch].unused) continue;
+            for (int f = 0; f < 6; ++f) {
+                const int a = f >> 1;
+                const uint32_t bit = 1u << a;
+                const bool split = (c.axes >> a) & 1, upper = (k & bit) != 0, plus = f & 1;
+                if (split && upper != plus) {  // the sibling on the other side of the midplane
+                    row[f] = first + (k ^ bit);
+                    continue;
+                }
+                uint32_t m = ropes[i * R + size_t(f)];
+                if (m != 0 && cells_[m].depth == c.depth && first_child_[m] != kNone)
+                    m = first_child_[m] + (split ? (k ^ bit) : k);  // its child facing this one
+                row[f] = m;
+            }
+        }
+    }
+    T.ropes.assign(T.leaves.size() * R, 0);  // by leaf (leaf 0: the root's row, all 0)
+    for (size_t l = 1; l < T.leaves.size(); ++l)
+        std::copy_n(&ropes[size_t(T.leaves[l].node) * R], R, &T.ropes[l * R]);
 }
 
 }  // namespace

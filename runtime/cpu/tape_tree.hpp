@@ -39,7 +39,7 @@ struct TapeTree {
             return x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1] && z >= lo[2] && z <= hi[2];
         }
     };
-    struct Leaf {
+    struct alignas(64) Leaf {  // one cache line
         float lo[3], hi[3];  // the box (leaf 0: empty box, so that lanes always re-locate)
         float ivlo, ivhi;    // the distance over the box
         const Instr* code;   // its tape (in `tapes`), len instructions, output register out
@@ -53,6 +53,13 @@ struct TapeTree {
     glm::vec3 lo{0}, hi{0};
     std::vector<Node> nodes;
     std::vector<NodeBox> boxes_;
+    // Ropes: row l (kRopeRow entries) holds, for each face of leaf l's box (-x, +x, -y, +y,
+    // -z, +z), the smallest node at least as big as the leaf on the other side of that face
+    // (0, the root, past the root's faces), then the leaf's own node. A point that left a
+    // leaf's box starts its lookup there instead of climbing from the leaf: a jump's landing
+    // point is nearly always in that neighbour.
+    static constexpr int kRopeRow = 8;
+    std::vector<uint32_t> ropes;
     std::vector<Leaf> leaves;
     std::vector<std::vector<Instr>> tapes;  // [0]: the full program
     uint32_t max_regs = 1;
@@ -68,6 +75,7 @@ struct TapeTree {
         max_regs = std::max<uint32_t>(p.num_regs, 1);
         nodes.clear();
         boxes_.clear();
+        ropes.clear();
         active = false;
     }
 
@@ -82,13 +90,31 @@ struct TapeTree {
         if (!active || !boxes_[0].holds(x, y, z)) return 0;
         return descend(0, x, y, z);
     }
-    // The same, starting from leaf `near` (a neighbour is found by climbing a level or two).
-    uint32_t locate_from(uint32_t near, float x, float y, float z) const {
-        if (!active) return 0;
-        uint32_t n = leaves[near].node;
+    // The face of box [lo, hi] that point p is beyond (the last one tested wins: any will
+    // do), or 6 when p is in the box.
+    static int face_beyond(const float lo[3], const float hi[3], float x, float y, float z) {
+        int f = 6;
+        f = z > hi[2] ? 5 : f;
+        f = z < lo[2] ? 4 : f;
+        f = y > hi[1] ? 3 : f;
+        f = y < lo[1] ? 2 : f;
+        f = x > hi[0] ? 1 : f;
+        f = x < lo[0] ? 0 : f;
+        return f;
+    }
+    // Where the lookup of a point that left leaf `near` (across face f) starts.
+    uint32_t rope(uint32_t near, int f) const { return ropes[size_t(near) * kRopeRow + size_t(f)]; }
+    // The leaf of the point, from node n: up to the first node that holds it, then down.
+    uint32_t find_from(uint32_t n, float x, float y, float z) const {
         while (n != 0 && !boxes_[n].holds(x, y, z)) n = boxes_[n].parent;
         if (n == 0 && !boxes_[0].holds(x, y, z)) return 0;
         return descend(n, x, y, z);
+    }
+    // The same, starting from leaf `near` (through its rope).
+    uint32_t locate_from(uint32_t near, float x, float y, float z) const {
+        if (!active) return 0;
+        const Leaf& L = leaves[near];
+        return find_from(rope(near, face_beyond(L.lo, L.hi, x, y, z)), x, y, z);
     }
 };
 

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "lang/load.hpp"
+#include "runtime/cpu/tape_tree.hpp"
 #include "runtime/cpu/tracer.hpp"
 #include "support.hpp"
 
@@ -177,6 +178,69 @@ TEST_CASE("accel: a raw field's tree splits cells however short their tapes, and
     CHECK(tape_r < 0.5 * tape_d);
     CHECK(r.sa.distance_points < r.sb.distance_points);
     CHECK(psnr(r.accel, r.base) >= 40.0);
+}
+
+TEST_CASE("accel: a leaf's ropes lead to its neighbours, and lookups through them find the point's leaf", "[accel]") {
+    // A raw field's deep tree over 144 spheres: every leaf's rope across each face is a node
+    // at least as big as the leaf whose box touches that face and covers it (or the root
+    // past the root's faces), and a point just past a face, found from the leaf, lands in
+    // a leaf that holds it: the one a lookup from the root finds.
+    auto c = test::compile_text(grid_scene(12, 160, 90, false));
+    cpu::TapeTree T;
+    const glm::vec3 lo(-6, -1, -6), hi(6, 1, 6);
+    cpu::build_tree(T, c->cs.distance, lo, hi, 0.0f, false, 160 * 90);
+    REQUIRE(T.active);
+    REQUIRE(T.leaves.size() > 1000);
+    size_t inner = 0, outer = 0, looked = 0, found = 0;
+    uint32_t rng = 12345;
+    auto uniform = [&] {
+        rng = rng * 1664525u + 1013904223u;
+        return float(rng >> 8) / float(1 << 24);
+    };
+    for (uint32_t l = 1; l < T.leaves.size(); ++l) {
+        const cpu::TapeTree::Leaf& L = T.leaves[l];
+        if (!(L.lo[0] <= L.hi[0])) continue;
+        for (int f = 0; f < 6; ++f) {
+            const int a = f >> 1;
+            const bool plus = f & 1;
+            const uint32_t m = T.rope(l, f);
+            const float face = plus ? L.hi[a] : L.lo[a];
+            if (m == 0) {
+                CHECK(face == (plus ? hi[a] : lo[a]));
+                ++outer;
+                continue;
+            }
+            const cpu::TapeTree::NodeBox& B = T.boxes_[m];
+            bool ok = (plus ? B.lo[a] : B.hi[a]) == face && B.hi[a] - B.lo[a] >= L.hi[a] - L.lo[a];
+            for (int b = 0; b < 3; ++b)
+                if (b != a) ok = ok && B.lo[b] <= L.lo[b] && B.hi[b] >= L.hi[b];
+            if (!ok) FAIL_CHECK("leaf " << l << " face " << f << ": rope " << m << " is not its neighbour");
+            ++inner;
+            // A point past the face (up to two leaf sizes), elsewhere random in the leaf.
+            float p[3];
+            for (int b = 0; b < 3; ++b) p[b] = L.lo[b] + uniform() * (L.hi[b] - L.lo[b]);
+            const float past = (0.01f + 2.0f * uniform()) * (L.hi[a] - L.lo[a]);
+            p[a] = plus ? face + past : face - past;
+            const uint32_t id = T.locate_from(l, p[0], p[1], p[2]);
+            const cpu::TapeTree::Leaf& R = T.leaves[id];
+            const bool holds = p[0] >= R.lo[0] && p[0] <= R.hi[0] && p[1] >= R.lo[1] && p[1] <= R.hi[1] && p[2] >= R.lo[2] &&
+                               p[2] <= R.hi[2];
+            const bool in_root = p[a] >= lo[a] && p[a] <= hi[a];
+            if (in_root) {
+                CHECK(holds);
+                ++looked;
+                found += id == T.locate(p[0], p[1], p[2]);
+            } else {
+                CHECK(id == 0);
+            }
+        }
+    }
+    INFO("ropes to neighbours " << inner << ", to the outside " << outer << ", lookups " << looked << ", as from the root "
+                                 << found);
+    CHECK(inner > 6 * 1000);
+    CHECK(outer > 0);
+    CHECK(looked > inner * 9 / 10);
+    CHECK(found == looked);  // (random points: none on a cell's face, which could go to either side)
 }
 
 TEST_CASE("accel: identical pixels for any thread count, with the tree", "[accel][determinism]") {
