@@ -419,4 +419,42 @@ float Worker::tile_start(int x0, int y0, int x1, int y1) {
     return t;
 }
 
+// The same for a raw field (no distance to march on), with its tape tree: the tile's cone
+// moves on along its axis leaf by leaf while every leaf that the cone's box over the step
+// meets is proven empty (the field positive all over it), so no ray of the tile can see a
+// sign change before the final t. A 16 x 16 tile's rays then skip together what they would
+// each have left by a jump per leaf (colonnade.vm at 1024^2: 22.2 -> 14.9 jumps a pixel,
+// 0.89x the time, the same picture).
+float Worker::tile_start_raw(int x0, int y0, int x1, int y1) {
+    if (!T_.active) return 0.0f;
+    glm::vec3 o, d;
+    glm::vec2 r;
+    rules::sdf_tile_cone(f_.camera.rule_camera(), static_cast<float>(x0), static_cast<float>(y0), static_cast<float>(x1),
+                         static_cast<float>(y1), o, d, r);
+    float t = f_.clip && f_.planes.empty() ? rules::sdf_premarch_begin(f_.lo, f_.hi, o, d, r, f_.max_dist) : 0.0f;
+    for (int i = 0; i < 64 && t < f_.max_dist; ++i) {
+        const glm::vec3 p = o + d * t;
+        const uint32_t id = T_.locate(p.x, p.y, p.z);
+        const TapeTree::Leaf& L = T_.leaves[id];
+        if (id == 0 || !(L.ivlo > 0.0f)) break;
+        float te = INFINITY;  // where the axis leaves the leaf's box
+        for (int a = 0; a < 3; ++a) {
+            if (d[a] > 0.0f) te = std::min(te, (L.hi[a] - o[a]) / d[a]);
+            else if (d[a] < 0.0f) te = std::min(te, (L.lo[a] - o[a]) / d[a]);
+        }
+        // A little past the exit (so that the next lookup finds the next leaf), covered by
+        // the margin of the box checked: every ray's point at any t' in [t, tn] is within
+        // r(t') of the axis's, which is on the segment [p, q].
+        const float step = 1e-3f * rules::sdf_max3(glm::vec3(L.hi[0] - L.lo[0], L.hi[1] - L.lo[1], L.hi[2] - L.lo[2]));
+        const float tn = std::min(std::max(te, t) + step, f_.max_dist);
+        if (!(tn > t)) break;
+        const glm::vec3 q = o + d * tn;
+        const float g = r.x + r.y * tn;
+        if (!T_.all_empty(glm::min(p, q) - g, glm::max(p, q) + g)) break;
+        t = tn;
+        ++stats.tile_skips;
+    }
+    return t;
+}
+
 }  // namespace sdfc::cpu

@@ -391,6 +391,30 @@ void TreeBuilder::make_ropes(TapeTree& T) const {
 
 }  // namespace
 
+bool TapeTree::all_empty(const glm::vec3& blo, const glm::vec3& bhi) const {
+    if (!active) return false;
+    for (int a = 0; a < 3; ++a)
+        if (!(blo[a] >= boxes_[0].lo[a] && bhi[a] <= boxes_[0].hi[a])) return false;  // (NaN: false)
+    uint32_t stack[8 * (kTreeMaxDepth + 1)];  // depth first: at most 8 a level
+    int sp = 0, visits = 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const Node& N = nodes[stack[--sp]];
+        if (N.child & kLeafBit) {
+            if (!(leaves[N.child & ~kLeafBit].ivlo > 0.0f)) return false;
+            continue;
+        }
+        if (++visits > kEmptyVisits) return false;
+        for (uint32_t k = 0; k < 8; ++k) {
+            const NodeBox& B = boxes_[N.child + k];  // (unused children: an empty box, never met)
+            const bool meets = B.lo[0] <= bhi.x && B.hi[0] >= blo.x && B.lo[1] <= bhi.y && B.hi[1] >= blo.y && B.lo[2] <= bhi.z &&
+                               B.hi[2] >= blo.z;
+            if (meets) stack[sp++] = N.child + k;
+        }
+    }
+    return true;
+}
+
 void build_tree(TapeTree& T, const Program& p, glm::vec3 lo, glm::vec3 hi, float time, bool lipschitz, size_t samples) {
     T.init_full(p);
     T.lo = lo;

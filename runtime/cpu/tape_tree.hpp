@@ -110,6 +110,11 @@ struct TapeTree {
         if (n == 0 && !boxes_[0].holds(x, y, z)) return 0;
         return descend(n, x, y, z);
     }
+    // Whether every leaf that meets the box [blo, bhi] is proven empty (ivlo > 0: the field
+    // is positive all over it), the box inside the root's. False too when that takes more
+    // than kEmptyVisits nodes (a box over much fine detail: not worth proving).
+    static constexpr int kEmptyVisits = 256;
+    bool all_empty(const glm::vec3& blo, const glm::vec3& bhi) const;
     // The same, starting from leaf `near` (through its rope).
     uint32_t locate_from(uint32_t near, float x, float y, float z) const {
         if (!active) return 0;

@@ -36,7 +36,7 @@ void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* d
     const glm::vec3 bg = f_.background;
 
     rays_.clear();
-    const float start = f_.premarch ? tile_start(x0, y0, x1, y1) : 0.0f;
+    const float start = f_.premarch ? tile_start(x0, y0, x1, y1) : (f_.raw && !f_.cone ? tile_start_raw(x0, y0, x1, y1) : 0.0f);
     for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
             const uint32_t pix = static_cast<uint32_t>((y - y0) * tw + (x - x0));

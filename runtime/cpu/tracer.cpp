@@ -103,6 +103,7 @@ void merge(RenderStats& total, const RenderStats& s) {
     total.distance_instructions += s.distance_instructions;
     total.shading_instructions += s.shading_instructions;
     total.skips += s.skips;
+    total.tile_skips += s.tile_skips;
     total.tree_leaves += s.tree_leaves;
     total.interval_boxes += s.interval_boxes;
     total.tree_ms += s.tree_ms;

@@ -76,11 +76,13 @@ struct RenderStats {
     uint64_t shading_points = 0;   // points evaluated by the shading (material) program
     uint64_t primary_rays = 0;
     // Cost detail (the tracer only): instructions run by the distance and shading
-    // evaluations (tape length x points), cells rays jumped over without an evaluation, and
-    // the tape tree (leaves, interval boxes evaluated to build it, build wall time).
+    // evaluations (tape length x points), cells rays jumped over without an evaluation, the
+    // leaves a raw field's tiles crossed together before their rays began (tile_start_raw),
+    // and the tape tree (leaves, interval boxes evaluated to build it, build wall time).
     uint64_t distance_instructions = 0;
     uint64_t shading_instructions = 0;
     uint64_t skips = 0;
+    uint64_t tile_skips = 0;
     uint64_t tree_leaves = 0, interval_boxes = 0;
     double tree_ms = 0.0;
 };

@@ -180,6 +180,21 @@ TEST_CASE("accel: a raw field's tree splits cells however short their tapes, and
     CHECK(psnr(r.accel, r.base) >= 40.0);
 }
 
+TEST_CASE("accel: a raw field's tiles of camera rays cross empty cells together", "[accel]") {
+    // Spheres on a floor seen from above, marked raw: the tiles begin at the camera (floor
+    // planes: no box to clip to) and cross the empty space above the spheres together, so
+    // their rays jump less; the picture stays the baseline's. (A distance's tiles pre-march
+    // on distances instead.)
+    auto c = test::compile_text(grid_scene(12, 160, 90, true));
+    const Pair d = render_both(c->cs);
+    c->cs.raw_field = true;
+    const Pair r = render_both(c->cs);
+    INFO("tile skips " << r.sa.tile_skips << ", skips " << r.sa.skips << ", psnr " << psnr(r.accel, r.base));
+    CHECK(r.sa.tile_skips > 0);
+    CHECK(d.sa.tile_skips == 0);
+    CHECK(psnr(r.accel, r.base) >= 40.0);
+}
+
 TEST_CASE("accel: a leaf's ropes lead to its neighbours, and lookups through them find the point's leaf", "[accel]") {
     // A raw field's deep tree over 144 spheres: every leaf's rope across each face is a node
     // at least as big as the leaf whose box touches that face and covers it (or the root
@@ -241,6 +256,22 @@ TEST_CASE("accel: a leaf's ropes lead to its neighbours, and lookups through the
     CHECK(outer > 0);
     CHECK(looked > inner * 9 / 10);
     CHECK(found == looked);  // (random points: none on a cell's face, which could go to either side)
+}
+
+TEST_CASE("accel: a box is proven empty only where every leaf it meets is", "[accel]") {
+    // 144 spheres of radius 0.4 c (c = 10 / 12) centred at height 0.3 c, in a root box from
+    // -6 to 6 (y: -1 to 1); the tree of a raw field (leaves as small as the surface asks).
+    auto c = test::compile_text(grid_scene(12, 160, 90, false));
+    cpu::TapeTree T;
+    cpu::build_tree(T, c->cs.distance, glm::vec3(-6, -1, -6), glm::vec3(6, 1, 6), 0.0f, false, 160 * 90);
+    REQUIRE(T.active);
+    const float cell = 10.0f / 12.0f, top = 0.7f * cell;  // the spheres' tops
+    const float x = 0.5f * cell;  // a sphere's centre: (x, 0.3 c, x)
+    CHECK(T.all_empty(glm::vec3(-0.4f, 0.8f, -0.4f), glm::vec3(x + 0.4f, 0.9f, x + 0.4f)));  // over the spheres
+    CHECK(T.all_empty(glm::vec3(5.3f, -0.5f, 5.3f), glm::vec3(5.6f, 0.5f, 5.6f)));            // past the grid's edge
+    CHECK_FALSE(T.all_empty(glm::vec3(x - 0.1f, top - 0.05f, x - 0.1f), glm::vec3(x + 0.1f, top + 0.2f, x + 0.1f)));  // a top
+    CHECK_FALSE(T.all_empty(glm::vec3(-0.4f, 0.8f, -0.4f), glm::vec3(x + 0.4f, 1.1f, x + 0.4f)));  // past the root's top
+    CHECK_FALSE(T.all_empty(glm::vec3(NAN, 0.9f, 0), glm::vec3(0, 0.95f, 0)));
 }
 
 TEST_CASE("accel: identical pixels for any thread count, with the tree", "[accel][determinism]") {
