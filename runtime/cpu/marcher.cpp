@@ -457,4 +457,34 @@ float Worker::tile_start_raw(int x0, int y0, int x1, int y1) {
     return t;
 }
 
+// A raw field's shadow rays toward one light (one tile's hits): the last part of every
+// segment, from the fraction u of its length on, lies in the box around the points at u and
+// the segments' ends; where the tree proves that box empty, no ray can meet a sign change
+// there, so each segment is cut at u (a ray that reaches the cut sees the light). u halves
+// from 1 while the box stays empty. Rays clipped to the scene's box only (their ends are then
+// inside the tree's root). Rays leaving the surface otherwise cross one leaf after another,
+// each bigger than the last (colonnade.vm at 1024^2: 14.9 -> 8.7 jumps a pixel, 0.91x the
+// time, the same picture).
+void Worker::raw_shadow_cut(RaySet& rs) {
+    const size_t n = rs.size();
+    if (!T_.active || !f_.clip || !f_.planes.empty() || n == 0) return;
+    auto empty_from = [&](float u) {
+        glm::vec3 lo(INFINITY), hi(-INFINITY);
+        for (size_t r = 0; r < n; ++r) {
+            const glm::vec3 o = rs.o(r), d = rs.d(r);
+            const glm::vec3 a = o + d * (u * rs.tmax[r]), e = o + d * rs.tmax[r];
+            lo = glm::min(lo, glm::min(a, e));
+            hi = glm::max(hi, glm::max(a, e));
+        }
+        // (a margin over the rounding of the marches' own sample points)
+        const float g = 1e-5f * (1.0f + std::max(rules::sdf_max3(glm::abs(lo)), rules::sdf_max3(glm::abs(hi))));
+        return T_.all_empty(lo - g, hi + g);
+    };
+    float cut = 2.0f;
+    for (float u = 1.0f; u >= 1.0f / 1024.0f && empty_from(u); u *= 0.5f) cut = u;
+    if (cut > 1.0f) return;
+    ++stats.shadow_cuts;
+    for (size_t r = 0; r < n; ++r) rs.tmax[r] = std::max(rs.tmin[r], cut * rs.tmax[r]);
+}
+
 }  // namespace sdfc::cpu

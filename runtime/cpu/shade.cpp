@@ -243,9 +243,14 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
         }
         if (shadow_.size() == 0) continue;
         kind_ = RenderStats::kShadows;
-        if (f_.raw) march_raw(shadow_, true);
-        else if (light.radius > 0.0f) shadow_soft(shadow_);
-        else shadow_hard(shadow_);
+        if (f_.raw) {
+            raw_shadow_cut(shadow_);
+            march_raw(shadow_, true);
+        } else if (light.radius > 0.0f) {
+            shadow_soft(shadow_);
+        } else {
+            shadow_hard(shadow_);
+        }
         kind_ = RenderStats::kRays;
         for (size_t s = 0; s < shadow_.size(); ++s)
             if (vis_[s] > 0.0f) add_shaded(shadow_.prim[s], glm::vec3(lrad_[s * 3], lrad_[s * 3 + 1], lrad_[s * 3 + 2]) * vis_[s]);

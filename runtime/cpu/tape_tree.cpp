@@ -350,6 +350,17 @@ void TreeBuilder::emit(TapeTree& T) {
         T.leaves.push_back(L);
     }
     make_ropes(T);
+    // Bottom up (children follow parents): which nodes hold only empty leaves (unused
+    // children are never reached, so count as empty).
+    for (size_t i = cells_.size(); i-- > 0;) {
+        const TapeTree::Node& node = T.nodes[i];
+        uint32_t e = 1;
+        if (cells_[i].unused) e = 1;
+        else if (node.child & TapeTree::kLeafBit) e = T.leaves[node.child & ~TapeTree::kLeafBit].ivlo > 0.0f;
+        else
+            for (uint32_t k = 0; k < 8; ++k) e &= T.boxes_[node.child + k].empty;
+        T.boxes_[i].empty = e;
+    }
 }
 
 // Top down (parents precede children): a child's neighbour across a face inside its parent
@@ -395,21 +406,21 @@ bool TapeTree::all_empty(const glm::vec3& blo, const glm::vec3& bhi) const {
     if (!active) return false;
     for (int a = 0; a < 3; ++a)
         if (!(blo[a] >= boxes_[0].lo[a] && bhi[a] <= boxes_[0].hi[a])) return false;  // (NaN: false)
+    if (boxes_[0].empty) return true;
     uint32_t stack[8 * (kTreeMaxDepth + 1)];  // depth first: at most 8 a level
     int sp = 0, visits = 0;
     stack[sp++] = 0;
     while (sp > 0) {
         const Node& N = nodes[stack[--sp]];
-        if (N.child & kLeafBit) {
-            if (!(leaves[N.child & ~kLeafBit].ivlo > 0.0f)) return false;
-            continue;
-        }
         if (++visits > kEmptyVisits) return false;
         for (uint32_t k = 0; k < 8; ++k) {
-            const NodeBox& B = boxes_[N.child + k];  // (unused children: an empty box, never met)
+            const uint32_t c = N.child + k;
+            const NodeBox& B = boxes_[c];
             const bool meets = B.lo[0] <= bhi.x && B.hi[0] >= blo.x && B.lo[1] <= bhi.y && B.hi[1] >= blo.y && B.lo[2] <= bhi.z &&
                                B.hi[2] >= blo.z;
-            if (meets) stack[sp++] = N.child + k;
+            if (!meets || B.empty) continue;
+            if (nodes[c].child & kLeafBit) return false;  // a leaf that may hold surface
+            stack[sp++] = c;
         }
     }
     return true;

@@ -34,7 +34,7 @@ struct TapeTree {
         float lo[3] = {0, 0, 0};
         uint32_t parent = 0;
         float hi[3] = {0, 0, 0};
-        uint32_t pad = 0;
+        uint32_t empty = 0;       // 1: every leaf under it is proven empty (all_empty)
         bool holds(float x, float y, float z) const {
             return x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1] && z >= lo[2] && z <= hi[2];
         }

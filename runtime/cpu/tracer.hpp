@@ -83,6 +83,7 @@ struct RenderStats {
     uint64_t shading_instructions = 0;
     uint64_t skips = 0;
     uint64_t tile_skips = 0;
+    uint64_t shadow_cuts = 0;  // a raw field's shadow ray sets cut short (raw_shadow_cut)
     uint64_t tree_leaves = 0, interval_boxes = 0;
     double tree_ms = 0.0;
 };

@@ -163,6 +163,7 @@ private:
     void shadow_soft(const RaySet& rs);
     float tile_start(int x0, int y0, int x1, int y1);
     float tile_start_raw(int x0, int y0, int x1, int y1);
+    void raw_shadow_cut(RaySet& rs);
 
     // Shading (shade.cpp).
     void compute_normals(const RaySet& h);
