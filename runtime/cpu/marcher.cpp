@@ -402,14 +402,20 @@ void Worker::shadow_soft(const RaySet& rs) {
         [](Lanes& L, int i) { L.t[i] = L.tmax[i]; });
 }
 
+// The cone around a tile's primary rays (rules.h sdf_tile_cone: axis o + t d, radius
+// r.x + r.y t) and the t where its pre-march begins (sdf_premarch_begin).
+float Worker::tile_cone(int x0, int y0, int x1, int y1, glm::vec3& o, glm::vec3& d, glm::vec2& r) const {
+    rules::sdf_tile_cone(f_.camera.rule_camera(), static_cast<float>(x0), static_cast<float>(y0), static_cast<float>(x1),
+                         static_cast<float>(y1), o, d, r);
+    return f_.clip && f_.planes.empty() ? rules::sdf_premarch_begin(f_.lo, f_.hi, o, d, r, f_.max_dist) : 0.0f;
+}
+
 // Tile cone pre-marching: one march along the tile's central ray for all its primary rays
 // (rules.h sdf_tile_cone, sdf_premarch_step: why it is safe); they start at the final t.
 float Worker::tile_start(int x0, int y0, int x1, int y1) {
     glm::vec3 o, d;
     glm::vec2 r;
-    rules::sdf_tile_cone(f_.camera.rule_camera(), static_cast<float>(x0), static_cast<float>(y0), static_cast<float>(x1),
-                         static_cast<float>(y1), o, d, r);
-    float t = f_.clip && f_.planes.empty() ? rules::sdf_premarch_begin(f_.lo, f_.hi, o, d, r, f_.max_dist) : 0.0f;
+    float t = tile_cone(x0, y0, x1, y1, o, d, r);
     for (int i = 0; i < 32 && t < f_.max_dist; ++i) {
         const glm::vec3 p = o + d * t;
         float dist;
@@ -429,9 +435,7 @@ float Worker::tile_start_raw(int x0, int y0, int x1, int y1) {
     if (!T_.active) return 0.0f;
     glm::vec3 o, d;
     glm::vec2 r;
-    rules::sdf_tile_cone(f_.camera.rule_camera(), static_cast<float>(x0), static_cast<float>(y0), static_cast<float>(x1),
-                         static_cast<float>(y1), o, d, r);
-    float t = f_.clip && f_.planes.empty() ? rules::sdf_premarch_begin(f_.lo, f_.hi, o, d, r, f_.max_dist) : 0.0f;
+    float t = tile_cone(x0, y0, x1, y1, o, d, r);
     for (int i = 0; i < 64 && t < f_.max_dist; ++i) {
         const glm::vec3 p = o + d * t;
         const uint32_t id = T_.locate(p.x, p.y, p.z);

@@ -161,6 +161,7 @@ private:
     void cone_march(const RaySet& rs);
     void shadow_hard(const RaySet& rs);
     void shadow_soft(const RaySet& rs);
+    float tile_cone(int x0, int y0, int x1, int y1, glm::vec3& o, glm::vec3& d, glm::vec2& r) const;
     float tile_start(int x0, int y0, int x1, int y1);
     float tile_start_raw(int x0, int y0, int x1, int y1);
     void raw_shadow_cut(RaySet& rs);

@@ -65,6 +65,20 @@ Pair render_both(const CompiledScene& cs, int threads = 2) {
     return p;
 }
 
+// The scene rendered (accelerated and baseline) as a distance, then marked raw (as a .vm
+// model is: no distance bound, sign-change steps).
+struct DistanceAndRaw {
+    Pair d, r;
+};
+DistanceAndRaw render_distance_and_raw(const std::string& src) {
+    auto c = test::compile_text(src);
+    DistanceAndRaw out;
+    out.d = render_both(c->cs);
+    c->cs.raw_field = true;
+    out.r = render_both(c->cs);
+    return out;
+}
+
 }  // namespace
 
 TEST_CASE("accel: a 12 x 12 grid of spheres matches the baseline, with far fewer instructions", "[accel]") {
@@ -165,10 +179,7 @@ TEST_CASE("accel: a raw field's tree splits cells however short their tapes, and
     // bound, sign-change steps) and as a distance: the raw field's cells go on splitting
     // below the 64-instruction tapes where a distance's stop, so more of its marches'
     // small steps become jumps over empty cells.
-    auto c = test::compile_text(grid_scene(12, 160, 90, false));
-    const Pair d = render_both(c->cs);
-    c->cs.raw_field = true;
-    const Pair r = render_both(c->cs);
+    const auto [d, r] = render_distance_and_raw(grid_scene(12, 160, 90, false));
     const double tape_d = double(d.sa.distance_instructions) / double(d.sa.distance_points);
     const double tape_r = double(r.sa.distance_instructions) / double(r.sa.distance_points);
     INFO("leaves " << d.sa.tree_leaves << " / " << r.sa.tree_leaves << ", tape " << tape_d << " / " << tape_r << ", skips "
@@ -187,10 +198,7 @@ TEST_CASE("accel: a raw field's shadow rays stop where the rest of their way is 
     // cuts (37.64 dB from the baseline, which raw marching's missed specks of the small
     // sphere cost, with or without them). (A distance's shadow rays are never cut: they
     // jump or step on distances.)
-    auto c = test::compile_text(grid_scene(12, 160, 90, false) + "translate([5, 3, 5]) sphere(0.3);\n");
-    const Pair d = render_both(c->cs);
-    c->cs.raw_field = true;
-    const Pair r = render_both(c->cs);
+    const auto [d, r] = render_distance_and_raw(grid_scene(12, 160, 90, false) + "translate([5, 3, 5]) sphere(0.3);\n");
     INFO("shadow cuts " << r.sa.shadow_cuts << ", skips " << r.sa.skips << ", psnr " << psnr(r.accel, r.base));
     CHECK(r.sa.shadow_cuts > 0);
     CHECK(d.sa.shadow_cuts == 0);
@@ -202,10 +210,7 @@ TEST_CASE("accel: a raw field's tiles of camera rays cross empty cells together"
     // planes: no box to clip to) and cross the empty space above the spheres together, so
     // their rays jump less; the picture stays the baseline's. (A distance's tiles pre-march
     // on distances instead.)
-    auto c = test::compile_text(grid_scene(12, 160, 90, true));
-    const Pair d = render_both(c->cs);
-    c->cs.raw_field = true;
-    const Pair r = render_both(c->cs);
+    const auto [d, r] = render_distance_and_raw(grid_scene(12, 160, 90, true));
     INFO("tile skips " << r.sa.tile_skips << ", skips " << r.sa.skips << ", psnr " << psnr(r.accel, r.base));
     CHECK(r.sa.tile_skips > 0);
     CHECK(d.sa.tile_skips == 0);
