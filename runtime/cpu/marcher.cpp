@@ -441,15 +441,12 @@ float Worker::tile_start_raw(int x0, int y0, int x1, int y1) {
         const uint32_t id = T_.locate(p.x, p.y, p.z);
         const TapeTree::Leaf& L = T_.leaves[id];
         if (id == 0 || !(L.ivlo > 0.0f)) break;
-        float te = INFINITY;  // where the axis leaves the leaf's box
-        for (int a = 0; a < 3; ++a) {
-            if (d[a] > 0.0f) te = std::min(te, (L.hi[a] - o[a]) / d[a]);
-            else if (d[a] < 0.0f) te = std::min(te, (L.lo[a] - o[a]) / d[a]);
-        }
+        float ts = t, te = INFINITY;  // te: where the axis leaves the leaf's box
+        rules::sdf_clip_box(glm::vec3(L.lo[0], L.lo[1], L.lo[2]), glm::vec3(L.hi[0], L.hi[1], L.hi[2]), o, d, ts, te);
         // A little past the exit (so that the next lookup finds the next leaf), covered by
         // the margin of the box checked: every ray's point at any t' in [t, tn] is within
         // r(t') of the axis's, which is on the segment [p, q].
-        const float step = 1e-3f * rules::sdf_max3(glm::vec3(L.hi[0] - L.lo[0], L.hi[1] - L.lo[1], L.hi[2] - L.lo[2]));
+        const float step = 1e-3f * rules::sdf_max3(glm::vec3(L.hi[0], L.hi[1], L.hi[2]) - glm::vec3(L.lo[0], L.lo[1], L.lo[2]));
         const float tn = std::min(std::max(te, t) + step, f_.max_dist);
         if (!(tn > t)) break;
         const glm::vec3 q = o + d * tn;

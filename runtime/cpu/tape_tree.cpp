@@ -355,10 +355,11 @@ void TreeBuilder::emit(TapeTree& T) {
     for (size_t i = cells_.size(); i-- > 0;) {
         const TapeTree::Node& node = T.nodes[i];
         uint32_t e = 1;
-        if (cells_[i].unused) e = 1;
-        else if (node.child & TapeTree::kLeafBit) e = T.leaves[node.child & ~TapeTree::kLeafBit].ivlo > 0.0f;
-        else
+        if (node.child & TapeTree::kLeafBit) {
+            if (!cells_[i].unused) e = T.leaves[node.child & ~TapeTree::kLeafBit].ivlo > 0.0f;
+        } else {
             for (uint32_t k = 0; k < 8; ++k) e &= T.boxes_[node.child + k].empty;
+        }
         T.boxes_[i].empty = e;
     }
 }
