@@ -32,6 +32,7 @@ struct Scene::Impl {
     bool ok = false;
     sdfc::Scene scene;
     CompiledScene compiled;
+    std::unique_ptr<Raster2d> raster;  // a 2D model, prepared once for every render
 };
 
 namespace {
@@ -66,6 +67,7 @@ std::shared_ptr<Scene::Impl> compile(std::shared_ptr<Scene::Impl> s) {
         s->scene = interpret(*s->sources, *s, s->options.time);
         for (const sdfc::Diagnostic& w : s->scene.warnings) s->diagnostics.push_back(convert(w, "warning"));
         s->compiled = compile_scene(s->scene);
+        if (s->compiled.is_2d && !s->compiled.distance.outputs.empty()) s->raster = std::make_unique<Raster2d>(s->compiled);
         s->ok = true;
     } catch (const CompileError& e) {
         for (const sdfc::Diagnostic& d : e.diagnostics()) s->diagnostics.push_back(convert(d, "error"));
@@ -137,7 +139,8 @@ Image Scene::render(const RenderSettings& r) const {
     if (r.samples) cs.render.samples = r.samples;
     sdfc::Image img;
     if (cs.is_2d) {
-        img = render_2d(cs, cs.render.width, cs.render.height, r.threads, false);
+        img = s.raster ? s.raster->render(cs.render.width, cs.render.height, r.threads)
+                       : sdfc::Image(std::max(cs.render.width, 1), std::max(cs.render.height, 1), 1);  // no field: nothing inside
     } else {
         RenderOptions ro;
         ro.threads = r.threads;

@@ -2,6 +2,7 @@
 // Prospero-style inside/outside image of 2D .vm models.
 #pragma once
 #include <array>
+#include <memory>
 #include <optional>
 
 #include "compiler/bytecode/compile.hpp"
@@ -26,5 +27,22 @@ Image render_slice(const CompiledScene& scene, const SliceOptions& opt);
 // y = +1, white where the field is < 0. `baseline` disables interval pruning.
 Image render_2d(const CompiledScene& scene, int w, int h, int threads = 0, bool baseline = false,
                 RenderStats* stats = nullptr);
+
+// A 2D model prepared for many pictures (bench's repeats, an API scene rendered again): its
+// root tape, linked and marked for the sign, made once, and the scratch of earlier renders,
+// kept warm. render() gives render_2d's image; it may run from several threads at once.
+// The scene must outlive it.
+class Raster2d {
+public:
+    explicit Raster2d(const CompiledScene& scene);
+    ~Raster2d();
+    Raster2d(const Raster2d&) = delete;
+    Raster2d& operator=(const Raster2d&) = delete;
+    Image render(int w, int h, int threads = 0, RenderStats* stats = nullptr) const;
+
+private:
+    struct Prepared;
+    std::unique_ptr<Prepared> p_;
+};
 
 }  // namespace sdfc

@@ -264,24 +264,27 @@ void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint
                 }
                 continue;
             }
-            const uint8_t* row = choices + size_t(sl) * size_t(stride);
-            for (; m; m &= m - 1) {
-                const size_t j = size_t(__builtin_ctzll(m));
-                const uint8_t ch = row[j];
-                if (ch == kChoiceBoth) {
-                    buf[j * n + cnt[j]++] = in;
-                    continue;
-                }
-                Instr c{Op::Copy};
+            // What each choice byte makes of the op, and whether it takes a place: chosen
+            // per lane without a branch (the lanes' choices mix unpredictably).
+            Instr as[4] = {in, Instr{Op::Copy}, Instr{Op::Copy}, Instr{Op::Copy}};
+            uint32_t keep[4] = {1, 1, 1, 1};
+            for (int ch = kChoiceA; ch <= kChoiceC; ++ch) {
+                Instr& c = as[ch];
                 c.out = in.out;
                 if (ch == kChoiceB && (in.op == Op::MinI || in.op == Op::MaxI)) {
                     c.op = Op::Const;
                     c.k = in.k;
                 } else {
                     c.a = ch == kChoiceA ? in.a : (ch == kChoiceB ? in.b : in.c);
-                    if (c.a == c.out) continue;  // the winner is already in place
+                    keep[ch] = c.a != c.out;  // else the winner is already in place
                 }
-                buf[j * n + cnt[j]++] = c;
+            }
+            const uint8_t* row = choices + size_t(sl) * size_t(stride);
+            for (; m; m &= m - 1) {
+                const size_t j = size_t(__builtin_ctzll(m));
+                const uint8_t ch = row[j] & 3;
+                buf[j * n + cnt[j]] = as[ch];
+                cnt[j] += keep[ch];
             }
         }
         for (uint64_t lm = lanes; lm; lm &= lm - 1) {

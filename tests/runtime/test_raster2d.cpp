@@ -3,6 +3,8 @@
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <thread>
+#include <vector>
 
 #include "compiler/bytecode/compile.hpp"
 #include "lang/load.hpp"
@@ -56,4 +58,30 @@ TEST_CASE("render_2d: hi.vm and quarter.vm equal brute force, odd sizes too") {
     check_identical("hi.vm", 301, 173);
     check_identical("quarter.vm", 77, 1000);
     check_identical("prospero.vm", 517, 263);
+}
+
+TEST_CASE("Raster2d: a prepared model draws the same image every time, from several threads at once") {
+    const fs::path path = fs::path(SDFC_SHARED_DIR) / "bench" / "vm" / "prospero.vm";
+    if (!fs::exists(path)) {
+        WARN("skipped: " << path << " is absent");
+        return;
+    }
+    SourceManager sm;
+    CompiledScene cs = compile_scene(load_scene(sm, path.string()));
+    RenderStats once;
+    const Image expect = render_2d(cs, 512, 384, 2, false, &once);
+    const Raster2d raster(cs);
+    // Sizes change between renders (the kept scratch is sized by the program, not the image),
+    // and each render counts only its own points.
+    for (int round = 0; round < 3; ++round) {
+        RenderStats st;
+        CHECK(raster.render(512, 384, 2, &st).pixels == expect.pixels);
+        CHECK(st.distance_points == once.distance_points);
+        CHECK(raster.render(97, 203, 1).pixels == render_2d(cs, 97, 203, 1).pixels);
+    }
+    std::vector<Image> got(4);
+    std::vector<std::thread> workers;
+    for (size_t i = 0; i < got.size(); ++i) workers.emplace_back([&, i] { got[i] = raster.render(512, 384, 2); });
+    for (auto& t : workers) t.join();
+    for (const Image& img : got) CHECK(img.pixels == expect.pixels);
 }
