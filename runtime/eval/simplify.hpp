@@ -58,7 +58,8 @@ struct BatchScratch {
 //   else:    a trace: the live instructions in the parent's registers, a decided choice
 //            op replaced by a copy of its winner (nothing if already in place) or by a
 //            constant. Cheaper to make, a little longer: for tapes evaluated once
-//            (leaves), not for parents of further simplification (copies would pile up).
+//            (leaves) or simplified once more (raster2d's tiles above its leaves), not
+//            for longer lines of descendants (copies would pile up).
 // The cost is about the parent's length plus the results' lengths.
 void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s,
                     bool compact = true);
