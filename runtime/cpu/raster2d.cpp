@@ -23,6 +23,7 @@
 // parent's, so the image is identical to brute-force evaluation (tests/runtime/test_raster2d.cpp, pixel by pixel).
 #include <algorithm>
 #include <atomic>
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -129,11 +130,12 @@ void fill(Ctx& c, int x0, int y0, int x1, int y1, float v) {
 
 // Pixels of the tile [x0, x0 + size)^2 (clipped), 8 x 8 pixels per VM batch.
 void leaf(Ctx& c, Scratch& s, const TapeView& tape, int x0, int y0, int size) {
+    alignas(64) static const float zs[kBatch] = {};  // a 2D model's z
     for (int by = y0; by < std::min(y0 + size, c.h); by += 8)
         for (int bx = x0; bx < std::min(x0 + size, c.w); bx += 8) {
             const int x1 = std::min(bx + 8, c.w), y1 = std::min(by + 8, c.h);
             const int cols = x1 - bx, rows = y1 - by, n = cols * rows;
-            float xs[kBatch], ys[kBatch], zs[kBatch];  // lanes >= n are never read
+            alignas(64) float xs[kBatch], ys[kBatch], in[kBatch];  // lanes >= n are never read
             const float* xc = c.xc.data() + bx;
             const float* yc = c.yc.data() + by;
             if (cols == 8 && rows == 8) {  // the common case, in fixed-size loops
@@ -141,10 +143,8 @@ void leaf(Ctx& c, Scratch& s, const TapeView& tape, int x0, int y0, int size) {
                     for (int q = 0; q < 8; ++q) {
                         xs[r * 8 + q] = xc[q];
                         ys[r * 8 + q] = yc[r];
-                        zs[r * 8 + q] = 0.0f;
                     }
             } else {
-                std::fill_n(zs, n, 0.0f);
                 for (int r = 0; r < rows; ++r)
                     for (int q = 0; q < cols; ++q) {
                         xs[r * cols + q] = xc[q];
@@ -153,16 +153,13 @@ void leaf(Ctx& c, Scratch& s, const TapeView& tape, int x0, int y0, int size) {
             }
             s.ev.eval(tape, xs, ys, zs, n, c.time);
             const float* d = s.ev.output(tape);
+            // Into a local row first: the compiler cannot tell the picture from the VM's
+            // registers, and would write pixel by pixel.
+            for (int i = 0; i < kBatch; ++i) in[i] = d[i] < 0.0f ? 1.0f : 0.0f;
             if (cols == 8 && rows == 8) {
-                for (int r = 0; r < 8; ++r) {
-                    float* row = c.px + size_t(by + r) * c.w + bx;
-                    for (int q = 0; q < 8; ++q) row[q] = d[r * 8 + q] < 0.0f ? 1.0f : 0.0f;
-                }
+                for (int r = 0; r < 8; ++r) std::memcpy(c.px + size_t(by + r) * c.w + bx, in + r * 8, 8 * sizeof(float));
             } else {
-                for (int r = 0; r < rows; ++r) {
-                    float* row = c.px + size_t(by + r) * c.w + bx;
-                    for (int q = 0; q < cols; ++q) row[q] = d[r * cols + q] < 0.0f ? 1.0f : 0.0f;
-                }
+                for (int r = 0; r < rows; ++r) std::copy_n(in + r * cols, cols, c.px + size_t(by + r) * c.w + bx);
             }
             s.points += uint64_t(n);
         }
