@@ -190,7 +190,9 @@ bool last_split(const Ctx& c, int depth) { return size_t(depth) + 2 >= c.sizes.s
 // Writes no pixel.
 void split(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0, Children& ch) {
     const int size = c.sizes[size_t(depth)];
-    if (!t.linked) t.link();
+    // (The root, shared by concurrent renders, was linked once by Raster2d: if that failed, a
+    // tape reading unwritten registers, it stays unlinked and is copied as is.)
+    if (!t.linked && depth > 0) t.link();
     ch.child = c.sizes[size_t(depth) + 1];
     ch.leaves = size_t(depth) + 2 == c.sizes.size();
     const int child = ch.child, per_axis = size / child;

@@ -30,8 +30,9 @@ Image render_2d(const CompiledScene& scene, int w, int h, int threads = 0, bool 
 
 // A 2D model prepared for many pictures (bench's repeats, an API scene rendered again): its
 // root tape, linked and marked for the sign, made once, and the scratch of earlier renders,
-// kept warm. render() gives render_2d's image; it may run from several threads at once.
-// The scene must outlive it.
+// kept warm (as much memory as one render's scratch, held while it lives). render() gives
+// render_2d's image; it may run from several threads at once. The scene must outlive it
+// and have a distance output.
 class Raster2d {
 public:
     explicit Raster2d(const CompiledScene& scene);

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <thread>
+#include <vector>
 
 using namespace sdfc::api;
 
@@ -110,4 +111,30 @@ TEST_CASE("pictures, GLSL and meshes of a compiled file") {
     const Scene plane = compile_string("plane();\n");
     CHECK_THROWS_WITH(plane.mesh(), "mesh: the scene is unbounded (a plane, an infinite repetition?): give MeshSettings::bounds");
     CHECK(std::string(version()).find('.') != std::string::npos);
+}
+
+TEST_CASE("a 2D model renders the same picture again, and from several threads at once") {
+    const std::string path = std::string(SDFC_SHARED_DIR) + "/bench/vm/quarter.vm";
+    if (!std::filesystem::exists(path)) {
+        WARN("skipped: " << path << " is absent");
+        return;
+    }
+    const Scene s = compile_file(path);
+    REQUIRE(s.ok());
+    RenderSettings rs;
+    rs.width = 96, rs.height = 80;
+    const Image first = s.render(rs);
+    REQUIRE(first.rgb.size() == 96u * 80u * 3u);
+    size_t white = 0;
+    for (float v : first.rgb) white += v == 1.0f;
+    CHECK(white > 0);
+    CHECK(white < first.rgb.size());
+    CHECK(s.render(rs).rgb == first.rgb);
+    std::vector<Image> got(3);
+    std::vector<std::thread> workers;
+    for (size_t i = 0; i < got.size(); ++i) workers.emplace_back([&, i] { got[i] = s.render(rs); });
+    for (auto& t : workers) t.join();
+    for (const Image& img : got) CHECK(img.rgb == first.rgb);
+    rs.width = 33, rs.height = 47;  // another size from the same prepared model
+    CHECK(s.render(rs).rgb.size() == 33u * 47u * 3u);
 }
