@@ -3,8 +3,8 @@
 // (evaluations per pixel by purpose, tape length, the 2D tree's leaves).
 #include <algorithm>
 #include <chrono>
-#include <memory>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 #include "cli/common.hpp"
@@ -34,7 +34,7 @@ int cmd_bench(Args& a) {
     // scratch: twice with glibc, whose first large block is mapped, freed, and then taken
     // from the heap) and thread start-up: --warmup of them run untimed (as hyperfine's
     // --warmup), and the very first one's time is printed apart (cold_ms).
-    // A 2D model is prepared once (its root tape), as a frame loop or an API scene does.
+    // A 2D model is prepared once (its root tape and scratch: Raster2d), as an API scene is.
     std::unique_ptr<Raster2d> raster;
     if (cs.is_2d && !baseline && !cs.distance.outputs.empty()) raster = std::make_unique<Raster2d>(cs);
     std::vector<double> ms;
