@@ -293,6 +293,20 @@ void process(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0) {
     descend(c, s, depth, ch);
 }
 
+// Every column's coord_x and every row's coord_y, for both ways of drawing the image.
+void pixel_grid(int w, int h, std::vector<float>& xc, std::vector<float>& yc) {
+    xc.resize(size_t(w));
+    yc.resize(size_t(h));
+    for (int i = 0; i < w; ++i) xc[size_t(i)] = coord_x(i, w);
+    for (int j = 0; j < h; ++j) yc[size_t(j)] = coord_y(j, h);
+}
+
+// At most `threads` worker threads while it lives (0: all).
+std::unique_ptr<tbb::global_control> thread_limit(int threads) {
+    if (threads <= 0) return nullptr;
+    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+}
+
 // The brute-force image: every pixel through the full program, rows of 64-point batches.
 Image render_brute(const CompiledScene& scene, const std::vector<float>& xc, const std::vector<float>& yc,
                    RenderStats* stats) {
@@ -340,15 +354,11 @@ Raster2d::~Raster2d() = default;
 Image Raster2d::render(int w, int h, int threads, RenderStats* stats) const {
     w = std::max(w, 1);
     h = std::max(h, 1);
-    std::unique_ptr<tbb::global_control> limit;
-    if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+    const auto limit = thread_limit(threads);
     Pool& pool = p_->pool;
     Ctx c{w, h, nullptr, p_->scene.time, &pool};
     c.threads = threads > 0 ? threads : tbb::this_task_arena::max_concurrency();
-    c.xc.resize(size_t(w));
-    c.yc.resize(size_t(h));
-    for (int i = 0; i < w; ++i) c.xc[size_t(i)] = coord_x(i, w);
-    for (int j = 0; j < h; ++j) c.yc[size_t(j)] = coord_y(j, h);
+    pixel_grid(w, h, c.xc, c.yc);
 
     int size = kLeaf;
     while (size < w || size < h) size *= 2;
@@ -378,13 +388,9 @@ Image Raster2d::render(int w, int h, int threads, RenderStats* stats) const {
 
 Image render_2d(const CompiledScene& scene, int w, int h, int threads, bool baseline, RenderStats* stats) {
     if (!baseline) return Raster2d(scene).render(w, h, threads, stats);
-    w = std::max(w, 1);
-    h = std::max(h, 1);
-    std::unique_ptr<tbb::global_control> limit;
-    if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
-    std::vector<float> xc(static_cast<size_t>(w)), yc(static_cast<size_t>(h));
-    for (int i = 0; i < w; ++i) xc[size_t(i)] = coord_x(i, w);
-    for (int j = 0; j < h; ++j) yc[size_t(j)] = coord_y(j, h);
+    const auto limit = thread_limit(threads);
+    std::vector<float> xc, yc;
+    pixel_grid(std::max(w, 1), std::max(h, 1), xc, yc);
     return render_brute(scene, xc, yc, stats);
 }
 
