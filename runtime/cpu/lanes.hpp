@@ -94,15 +94,20 @@ struct Lanes {
         ivlo[to] = ivlo[from], ivhi[to] = ivhi[from], leaf[to] = leaf[from];
         steps[to] = steps[from], done[to] = done[from], ray[to] = ray[from];
     }
-    // Where ray i leaves its leaf's box (its t; possibly a little below t[i] by rounding).
-    float exit_t(int i) const {
+    // Where ray i leaves the box [lo, hi] (its t; possibly a little below t[i] by rounding).
+    float exit_t(int i, const float lo[3], const float hi[3]) const {
         float te = INFINITY;
         const float o[3] = {ox[i], oy[i], oz[i]}, d[3] = {dx[i], dy[i], dz[i]};
         for (int k = 0; k < 3; ++k) {
-            if (d[k] > 0.0f) te = std::min(te, (bhi[k][i] - o[k]) / d[k]);
-            else if (d[k] < 0.0f) te = std::min(te, (blo[k][i] - o[k]) / d[k]);
+            if (d[k] > 0.0f) te = std::min(te, (hi[k] - o[k]) / d[k]);
+            else if (d[k] < 0.0f) te = std::min(te, (lo[k] - o[k]) / d[k]);
         }
         return te;
+    }
+    // ... its leaf's box.
+    float exit_t(int i) const {
+        const float lo[3] = {blo[0][i], blo[1][i], blo[2][i]}, hi[3] = {bhi[0][i], bhi[1][i], bhi[2][i]};
+        return exit_t(i, lo, hi);
     }
 };
 

@@ -350,17 +350,27 @@ void TreeBuilder::emit(TapeTree& T) {
         T.leaves.push_back(L);
     }
     make_ropes(T);
-    // Bottom up (children follow parents): which nodes hold only empty leaves (unused
-    // children are never reached, so count as empty).
+    // Bottom up (children follow parents): which nodes hold only empty leaves, and their
+    // least lower bound (unused children are never reached, so count as empty).
     for (size_t i = cells_.size(); i-- > 0;) {
         const TapeTree::Node& node = T.nodes[i];
-        uint32_t e = 1;
+        float e = INFINITY;
         if (node.child & TapeTree::kLeafBit) {
-            if (!cells_[i].unused) e = T.leaves[node.child & ~TapeTree::kLeafBit].ivlo > 0.0f;
+            if (!cells_[i].unused) e = T.leaves[node.child & ~TapeTree::kLeafBit].ivlo;
         } else {
-            for (uint32_t k = 0; k < 8; ++k) e &= T.boxes_[node.child + k].empty;
+            for (uint32_t k = 0; k < 8; ++k) e = std::min(e, T.boxes_[node.child + k].elo);  // (-inf wins)
         }
-        T.boxes_[i].empty = e;
+        T.boxes_[i].elo = e > 0.0f ? e : -INFINITY;  // (NaN: not empty)
+    }
+    // Top down: each node's biggest empty ancestor (itself if its parent is not empty).
+    std::vector<uint32_t> up(cells_.size());
+    for (size_t i = 0; i < cells_.size(); ++i) {
+        const uint32_t p = T.boxes_[i].parent;
+        up[i] = i != 0 && T.boxes_[p].empty() ? up[p] : static_cast<uint32_t>(i);
+    }
+    for (size_t l = 1; l < T.leaves.size(); ++l) {
+        TapeTree::Leaf& L = T.leaves[l];
+        L.up = L.ivlo > 0.0f ? up[L.node] : L.node;
     }
 }
 
@@ -407,7 +417,7 @@ bool TapeTree::all_empty(const glm::vec3& blo, const glm::vec3& bhi) const {
     if (!active) return false;
     for (int a = 0; a < 3; ++a)
         if (!(blo[a] >= boxes_[0].lo[a] && bhi[a] <= boxes_[0].hi[a])) return false;  // (NaN: false)
-    if (boxes_[0].empty) return true;
+    if (boxes_[0].empty()) return true;
     uint32_t stack[8 * (kTreeMaxDepth + 1)];  // depth first: at most 8 a level
     int sp = 0, visits = 0;
     stack[sp++] = 0;
@@ -419,7 +429,7 @@ bool TapeTree::all_empty(const glm::vec3& blo, const glm::vec3& bhi) const {
             const NodeBox& B = boxes_[c];
             const bool meets = B.lo[0] <= bhi.x && B.hi[0] >= blo.x && B.lo[1] <= bhi.y && B.hi[1] >= blo.y && B.lo[2] <= bhi.z &&
                                B.hi[2] >= blo.z;
-            if (!meets || B.empty) continue;
+            if (!meets || B.empty()) continue;
             if (nodes[c].child & kLeafBit) return false;  // a leaf that may hold surface
             stack[sp++] = c;
         }

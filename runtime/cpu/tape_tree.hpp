@@ -7,7 +7,9 @@
 //
 // Rays locate the leaf of each point (a lane caches its leaf's box), evaluate that leaf's
 // tape, and when the leaf's interval proves it empty (no surface: for a 1-Lipschitz bound,
-// d >= ivlo > 0 everywhere in it) jump to where they leave the box, plus ivlo.
+// d >= ivlo > 0 everywhere in it) jump to where they leave the box, plus ivlo; or, outside
+// solids, to where they leave the biggest box around it whose leaves are all empty
+// (Leaf::up), plus that box's least bound (NodeBox::elo).
 // The build (split policy, budgets) is in tape_tree.cpp; the lookups are here, inline,
 // because every ray step makes one.
 #pragma once
@@ -34,7 +36,10 @@ struct TapeTree {
         float lo[3] = {0, 0, 0};
         uint32_t parent = 0;
         float hi[3] = {0, 0, 0};
-        uint32_t empty = 0;       // 1: every leaf under it is proven empty (all_empty)
+        // The least of its leaves' ivlo when every leaf under it is proven empty (> 0: the
+        // field is at least that all over the box), else -inf.
+        float elo = -INFINITY;
+        bool empty() const { return elo > 0.0f; }
         bool holds(float x, float y, float z) const {
             return x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1] && z >= lo[2] && z <= hi[2];
         }
@@ -46,10 +51,14 @@ struct TapeTree {
         uint32_t len;
         uint16_t out;
         uint32_t node;       // its node (leaf 0: the root)
+        // The biggest node around an empty leaf all of whose leaves are empty (a ray outside
+        // solids may jump through its whole box); else the leaf's own node.
+        uint32_t up;
         const Guard* guards = nullptr;  // leaf 0: the program's (the VM skips far regions)
         // The tape for an evaluator sized to the tree's max_regs.
         TapeView view() const { return TapeView{code, len, &out, 1, 0, TapeView::kUncounted, guards}; }
     };
+    static_assert(sizeof(Leaf) == 64);
     glm::vec3 lo{0}, hi{0};
     std::vector<Node> nodes;
     std::vector<NodeBox> boxes_;
@@ -71,7 +80,7 @@ struct TapeTree {
         tapes.assign(1, p.code);
         constexpr float inf = INFINITY;
         leaves.assign(1, Leaf{{inf, inf, inf}, {-inf, -inf, -inf}, -inf, inf, tapes[0].data(), static_cast<uint32_t>(tapes[0].size()),
-                              p.outputs.empty() ? uint16_t(0) : p.outputs[0], 0, p.guards.empty() ? nullptr : p.guards.data()});
+                              p.outputs.empty() ? uint16_t(0) : p.outputs[0], 0, 0, p.guards.empty() ? nullptr : p.guards.data()});
         max_regs = std::max<uint32_t>(p.num_regs, 1);
         nodes.clear();
         boxes_.clear();

@@ -154,6 +154,8 @@ private:
     template <class Init, class Update, class Finish, class Empty, class Skip, class Out>
     void run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish, Empty&& empty, Skip&& skip, Out&& out);
     bool skip_sphere(Lanes& L, int i, float slo, float te);
+    template <class Skip>
+    bool jump(Lanes& L, int i, Skip& skip);
 
     // The marches (marcher.cpp): camera and secondary rays, raw fields, cones, shadows.
     void march(const RaySet& rs);

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <mutex>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "lang/load.hpp"
 #include "runtime/cpu/tape_tree.hpp"
@@ -294,6 +296,64 @@ TEST_CASE("accel: a box is proven empty only where every leaf it meets is", "[ac
     CHECK_FALSE(T.all_empty(glm::vec3(x - 0.1f, top - 0.05f, x - 0.1f), glm::vec3(x + 0.1f, top + 0.2f, x + 0.1f)));  // a top
     CHECK_FALSE(T.all_empty(glm::vec3(-0.4f, 0.8f, -0.4f), glm::vec3(x + 0.4f, 1.1f, x + 0.4f)));  // past the root's top
     CHECK_FALSE(T.all_empty(glm::vec3(NAN, 0.9f, 0), glm::vec3(0, 0.95f, 0)));
+}
+
+namespace {
+// Checks Leaf::up and NodeBox::elo of T against brute force; returns the empty leaves and
+// how many of them have a bigger empty box.
+std::pair<size_t, size_t> check_empty_ancestors(const cpu::TapeTree& T) {
+    // elo by brute force: the least ivlo of the leaves under each node (leaves' nodes climbed
+    // to the root), -inf where any of them is not empty.
+    std::vector<float> elo(T.nodes.size(), INFINITY);
+    for (uint32_t l = 1; l < T.leaves.size(); ++l) {
+        const float v = T.leaves[l].ivlo > 0.0f ? T.leaves[l].ivlo : -INFINITY;
+        for (uint32_t n = T.leaves[l].node;; n = T.boxes_[n].parent) {
+            elo[n] = std::min(elo[n], v);
+            if (n == 0) break;
+        }
+    }
+    for (size_t n = 0; n < T.nodes.size(); ++n)
+        if (T.boxes_[n].elo != (elo[n] > 0.0f ? elo[n] : -INFINITY)) FAIL_CHECK("node " << n << ": elo " << T.boxes_[n].elo);
+    size_t empty_leaves = 0, bigger = 0;
+    for (uint32_t l = 1; l < T.leaves.size(); ++l) {
+        const cpu::TapeTree::Leaf& L = T.leaves[l];
+        if (!(L.ivlo > 0.0f)) {
+            CHECK(L.up == L.node);
+            continue;
+        }
+        ++empty_leaves;
+        const cpu::TapeTree::NodeBox& U = T.boxes_[L.up];
+        bool ok = U.empty() && U.elo <= L.ivlo && (L.up == 0 || !T.boxes_[U.parent].empty());
+        for (int a = 0; a < 3; ++a) ok = ok && U.lo[a] <= L.lo[a] && U.hi[a] >= L.hi[a];
+        for (uint32_t n = L.node; n != L.up && ok; n = T.boxes_[n].parent) ok = n != 0 && T.boxes_[n].empty();
+        if (!ok) FAIL_CHECK("leaf " << l << ": up " << L.up << " is not its biggest empty ancestor");
+        bigger += L.up != L.node;
+    }
+    return {empty_leaves, bigger};
+}
+}  // namespace
+
+TEST_CASE("accel: an empty leaf's biggest empty ancestor, and every node's least lower bound", "[accel]") {
+    SECTION("a raw field's tree: the grid of spheres without its floor") {
+        auto c = test::compile_text(grid_scene(12, 160, 90, false));
+        cpu::TapeTree T;
+        cpu::build_tree(T, c->cs.distance, glm::vec3(-6, -1, -6), glm::vec3(6, 1, 6), 0.0f, false, 160 * 90);
+        REQUIRE(T.active);
+        const auto [empty_leaves, bigger] = check_empty_ancestors(T);
+        INFO("empty leaves " << empty_leaves << ", with a bigger empty box " << bigger);
+        CHECK(empty_leaves > 1000);
+    }
+    SECTION("recursive1's sponges: empty cells near the surface split into empty children") {
+        SourceManager sm;
+        CompiledScene cs = compile_scene(load_scene(sm, std::string(SDFC_SOURCE_DIR) + "/examples/recursive1.sdf"));
+        cpu::TapeTree T;
+        cpu::build_tree(T, cs.distance, glm::vec3(-3.5f, -1.2f, -3.5f), glm::vec3(3.5f, 1.5f, 2.5f), 0.0f, true, 320 * 180);
+        REQUIRE(T.active);
+        const auto [empty_leaves, bigger] = check_empty_ancestors(T);
+        INFO("empty leaves " << empty_leaves << ", with a bigger empty box " << bigger);
+        CHECK(empty_leaves > 100);
+        CHECK(bigger > empty_leaves / 8);  // (measured: 246 of 1,075)
+    }
 }
 
 TEST_CASE("accel: identical pixels for any thread count, with the tree", "[accel][determinism]") {
