@@ -87,6 +87,9 @@ struct Lanes {
     }
     // Lower bound of sign * d over the lane's leaf: > 0 when the leaf is empty for the lane.
     float slo(int i) const { return sign[i] > 0.0f ? ivlo[i] : -ivhi[i]; }
+    // Whether a lower bound `lower` around the point leaves the lane's last over-relaxed step in
+    // doubt (the spheres may not overlap): the jumps of relaxed marches then step back.
+    bool relaxed_doubt(int i, float lower) const { return om[i] > 1.0f && lower + pr[i] < sl[i]; }
     void move(int from, int to) {
         ox[to] = ox[from], oy[to] = oy[from], oz[to] = oz[from];
         dx[to] = dx[from], dy[to] = dy[from], dz[to] = dz[from];

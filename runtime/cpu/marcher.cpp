@@ -169,8 +169,7 @@ bool Worker::jump(Lanes& L, int i, Skip& skip) {
     if (L.sign[i] > 0.0f && lf.up != lf.node) {
         const TapeTree::NodeBox& B = T_.boxes_[lf.up];
         const float ta = std::min(L.exit_t(i, B.lo, B.hi), L.tmax[i]);
-        const bool doubt = L.om[i] > 1.0f && B.elo + L.pr[i] < L.sl[i];
-        if (ta > te && !doubt && skip(L, i, B.elo, ta)) return true;
+        if (ta > te && !L.relaxed_doubt(i, B.elo) && skip(L, i, B.elo, ta)) return true;
     }
     return skip(L, i, L.slo(i), te);
 }
@@ -182,7 +181,7 @@ bool Worker::jump(Lanes& L, int i, Skip& skip) {
 // know), it is treated as failed instead, without an evaluation: back to the previous
 // sphere's boundary, omega = 1 (as march() does), and the jump is decided from there.
 inline bool Worker::skip_sphere(Lanes& L, int i, float slo, float te) {
-    if (L.om[i] > 1.0f && slo + L.pr[i] < L.sl[i]) {
+    if (L.relaxed_doubt(i, slo)) {
         L.t[i] += L.pr[i] - L.sl[i];
         L.om[i] = 1.0f, L.pr[i] = 0.0f, L.sl[i] = 0.0f;
         return true;
@@ -404,7 +403,7 @@ void Worker::shadow_soft(const RaySet& rs) {
         },
         [](uint32_t) {},
         [&](Lanes& L, int i, float slo, float te) {
-            if (L.om[i] > 1.0f && slo + L.pr[i] < L.sl[i]) {  // as in skip_sphere()
+            if (L.relaxed_doubt(i, slo)) {  // as in skip_sphere()
                 L.t[i] += L.pr[i] - L.sl[i];
                 L.om[i] = 1.0f, L.pr[i] = 0.0f, L.sl[i] = 0.0f;
                 return true;
