@@ -51,7 +51,31 @@ Frame make_frame(const CompiledScene& scene, const RenderOptions& options) {
     return f;
 }
 
-bool tree_root(const Frame& f, const CompiledScene& scene, const RenderOptions& options, glm::vec3& root_lo, glm::vec3& root_hi) {
+namespace {
+// A thin layer of surfaces (many small objects on a plane: the content's extent along an
+// axis under 1/32 of the root's largest, thinner than the tree's cells usually get) lies
+// across the root's midplane on that axis, and so across a split plane of every cell over
+// it: twice the surface cells for the tree's node budget. So the root is widened on that
+// axis (it covers what it did) to centre just below the layer, which then sits on the
+// lower face of its cells at every depth (the 10,000-sphere grid of bench/run at 640 x 360:
+// leaf tapes 200 -> 156 instructions a point with the node budget render() then gives,
+// 0.79x the time). True when it did.
+bool settle_thin_layer(const glm::vec3& clo, const glm::vec3& chi, glm::vec3& root_lo, glm::vec3& root_hi) {
+    const float m = rules::sdf_max3(root_hi - root_lo);
+    bool thin = false;
+    for (int a = 0; a < 3; ++a) {
+        if (!(clo[a] >= root_lo[a] && chi[a] <= root_hi[a] && chi[a] - clo[a] < m / 32)) continue;  // (not finite: no)
+        const float base = clo[a] - 1e-3f * m, h = std::max(base - root_lo[a], root_hi[a] - base);
+        root_lo[a] = base - h;
+        root_hi[a] = base + h;
+        thin = true;
+    }
+    return thin;
+}
+}  // namespace
+
+bool tree_root(const Frame& f, const CompiledScene& scene, const RenderOptions& options, glm::vec3& root_lo, glm::vec3& root_hi,
+               bool* thin_layer) {
     bool want_tree = !options.baseline && f.has_distance && !scene.is_2d && scene.distance.code.size() >= kTreeMinProgram;
     if (want_tree) {
         // Around the region rays can reach: the (clip) box with room for normal and AO taps,
@@ -72,6 +96,8 @@ bool tree_root(const Frame& f, const CompiledScene& scene, const RenderOptions& 
             }
         }
         for (int a = 0; a < 3; ++a) want_tree &= std::isfinite(root_lo[a]) && std::isfinite(root_hi[a]) && root_lo[a] < root_hi[a];
+        const bool thin = want_tree && settle_thin_layer(f.clip ? f.lo : scene.bounds.lo, f.clip ? f.hi : scene.bounds.hi, root_lo, root_hi);
+        if (thin_layer) *thin_layer = thin;
     }
     return want_tree;
 }

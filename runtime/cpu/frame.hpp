@@ -73,7 +73,9 @@ struct Frame : RenderPlan {
 Frame make_frame(const CompiledScene& scene, const RenderOptions& options);
 
 // Where the tape tree goes: false when the frame gets none (baseline, no distance, a short
-// program, a 2D model, or no finite box); else its root box in lo, hi.
-bool tree_root(const Frame& f, const CompiledScene& scene, const RenderOptions& options, glm::vec3& lo, glm::vec3& hi);
+// program, a 2D model, or no finite box); else its root box in lo, hi, and in *thin_layer
+// whether that box was centred under a thin layer of surfaces (frame.cpp settle_thin_layer).
+bool tree_root(const Frame& f, const CompiledScene& scene, const RenderOptions& options, glm::vec3& lo, glm::vec3& hi,
+               bool* thin_layer = nullptr);
 
 }  // namespace sdfc::cpu

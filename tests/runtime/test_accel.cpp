@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "lang/load.hpp"
+#include "runtime/cpu/frame.hpp"
 #include "runtime/cpu/tape_tree.hpp"
 #include "runtime/cpu/tracer.hpp"
 #include "support.hpp"
@@ -174,6 +175,33 @@ TEST_CASE("accel: 3,600 floating spheres match the baseline, their tree capped a
     CHECK(p.sa.tree_leaves > 1000);
     CHECK(p.sa.tree_leaves <= 4096);
     CHECK(p.sa.distance_instructions * 4 <= p.sb.distance_instructions);
+}
+
+TEST_CASE("accel: a thin layer of shapes lies above the tree root's midplane, not across it", "[accel]") {
+    // 3,600 floating spheres 0.13 high over 10 x 10: on y the root is centred just below them
+    // (each cell's lower face then holds the layer), and it still covers the box and its pad.
+    RenderOptions ro;
+    auto thin = test::compile_text(grid_scene(60, 160, 90, false));
+    const cpu::Frame f = cpu::make_frame(thin->cs, ro);
+    glm::vec3 lo, hi;
+    REQUIRE(f.clip);
+    bool layer = false;
+    REQUIRE(cpu::tree_root(f, thin->cs, ro, lo, hi, &layer));
+    CHECK(layer);  // (the tree then gets two thirds of the node budget)
+    const float mid = 0.5f * (lo.y + hi.y);
+    INFO("box y " << f.lo.y << " .. " << f.hi.y << ", root y " << lo.y << " .. " << hi.y);
+    CHECK(mid < f.lo.y);
+    CHECK(mid > f.lo.y - 0.05f);
+    CHECK(lo.y <= f.lo.y - 0.25f);
+    CHECK(hi.y >= f.hi.y + 0.25f);
+    CHECK(0.5f * (lo.x + hi.x) == Approx(0.5f * (f.lo.x + f.hi.x)).margin(1e-4));  // x and z are not thin
+    CHECK(0.5f * (lo.z + hi.z) == Approx(0.5f * (f.lo.z + f.hi.z)).margin(1e-4));
+    // 64 spheres 1.0 high over 10 x 10 are not a thin layer: the root stays centred on the box.
+    auto thick = test::compile_text(grid_scene(8, 160, 90, false));
+    const cpu::Frame g = cpu::make_frame(thick->cs, ro);
+    REQUIRE(cpu::tree_root(g, thick->cs, ro, lo, hi, &layer));
+    CHECK_FALSE(layer);
+    CHECK(0.5f * (lo.y + hi.y) == Approx(0.5f * (g.lo.y + g.hi.y)).margin(1e-4));
 }
 
 TEST_CASE("accel: a raw field's tree splits cells however short their tapes, and its rays jump more", "[accel]") {
