@@ -45,8 +45,11 @@ struct Lanes {
     alignas(64) float om[kWindow], pr[kWindow], sl[kWindow];
     alignas(64) float x[kWindow], y[kWindow], z[kWindow], dist[kWindow];
     alignas(64) float blo[3][kWindow], bhi[3][kWindow], ivlo[kWindow], ivhi[kWindow];  // the lane's leaf
+    // Raw fields (Worker::segment_bounds): seg, a lower bound of sign * f on the ray from t
+    // to where it leaves its leaf (-inf: none); tested, the last leaf one was sought in.
+    alignas(64) float seg[kWindow];
     alignas(64) int32_t steps[kWindow], done[kWindow], idx[kWindow];
-    alignas(64) uint32_t ray[kWindow], leaf[kWindow];
+    alignas(64) uint32_t ray[kWindow], leaf[kWindow], tested[kWindow];
     void load(int i, const RaySet& rs, uint32_t r, float relax) {
         ox[i] = rs.ox[r], oy[i] = rs.oy[r], oz[i] = rs.oz[r];
         dx[i] = rs.dx[r], dy[i] = rs.dy[r], dz[i] = rs.dz[r];
@@ -58,9 +61,11 @@ struct Lanes {
         ray[i] = r;
         for (int k = 0; k < 3; ++k) blo[k][i] = INFINITY, bhi[k][i] = -INFINITY;  // no leaf yet
         leaf[i] = 0, ivlo[i] = -INFINITY, ivhi[i] = INFINITY;
+        seg[i] = -INFINITY, tested[i] = 0;
     }
     void set_leaf(int i, uint32_t id, const TapeTree::Leaf& L) {
         leaf[i] = id;
+        seg[i] = -INFINITY;
         for (int k = 0; k < 3; ++k) blo[k][i] = L.lo[k], bhi[k][i] = L.hi[k];
         ivlo[i] = L.ivlo, ivhi[i] = L.ivhi;
     }
@@ -85,8 +90,12 @@ struct Lanes {
         for (int j = 0; j < m; ++j) __builtin_prefetch(&T.leaves[n[j]]);
         for (int j = 0; j < m; ++j) set_leaf(idx[j], n[j], T.leaves[n[j]]);
     }
-    // Lower bound of sign * d over the lane's leaf: > 0 when the leaf is empty for the lane.
-    float slo(int i) const { return sign[i] > 0.0f ? ivlo[i] : -ivhi[i]; }
+    // Lower bound of sign * d over the lane's leaf, or over its ray's way through the leaf
+    // when that is known to be more (seg): > 0 when the lane may jump out of the leaf.
+    float slo(int i) const {
+        const float s = sign[i] > 0.0f ? ivlo[i] : -ivhi[i];
+        return seg[i] > s ? seg[i] : s;
+    }
     // Whether a lower bound `lower` around the point leaves the lane's last over-relaxed step in
     // doubt (the spheres may not overlap): the jumps of relaxed marches then step back.
     bool relaxed_doubt(int i, float lower) const { return om[i] > 1.0f && lower + pr[i] < sl[i]; }
@@ -99,6 +108,7 @@ struct Lanes {
         x[to] = x[from], y[to] = y[from], z[to] = z[from], dist[to] = dist[from];
         for (int k = 0; k < 3; ++k) blo[k][to] = blo[k][from], bhi[k][to] = bhi[k][from];
         ivlo[to] = ivlo[from], ivhi[to] = ivhi[from], leaf[to] = leaf[from];
+        seg[to] = seg[from], tested[to] = tested[from];
         steps[to] = steps[from], done[to] = done[from], ray[to] = ray[from];
     }
     // Where ray i leaves the box [lo, hi] (its t; possibly a little below t[i] by rounding).

@@ -105,6 +105,7 @@ void merge(RenderStats& total, const RenderStats& s) {
     total.skips += s.skips;
     total.tile_skips += s.tile_skips;
     total.shadow_cuts += s.shadow_cuts;
+    total.segment_skips += s.segment_skips;
     total.tree_leaves += s.tree_leaves;
     total.interval_boxes += s.interval_boxes;
     total.tree_ms += s.tree_ms;

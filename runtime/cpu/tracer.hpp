@@ -84,6 +84,7 @@ struct RenderStats {
     uint64_t skips = 0;
     uint64_t tile_skips = 0;
     uint64_t shadow_cuts = 0;  // a raw field's shadow ray sets cut short (raw_shadow_cut)
+    uint64_t segment_skips = 0;  // of skips: a raw field's rays through cells not empty (segment_bounds)
     uint64_t tree_leaves = 0, interval_boxes = 0;
     double tree_ms = 0.0;
 };

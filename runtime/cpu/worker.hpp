@@ -12,6 +12,7 @@
 #include "runtime/cpu/frame.hpp"
 #include "runtime/cpu/lanes.hpp"
 #include "runtime/cpu/rays.hpp"
+#include "runtime/eval/interval.hpp"
 #include "runtime/eval/vm.hpp"
 #include "runtime/io/image.hpp"
 
@@ -56,6 +57,7 @@ private:
 
     std::unique_ptr<Lanes> lanes_;
     std::unique_ptr<Buckets> buckets_;
+    std::unique_ptr<IntervalEvaluator> seg_iv_;  // raw fields' segment bounds (segment_bounds)
 
     // Distances at n <= kWindow points that all lie in leaf `id`.
     void eval_leaf(uint32_t id, const float* x, const float* y, const float* z, int n, float* out) {
@@ -152,7 +154,9 @@ private:
     template <class Finish>
     void retire(Lanes& L, int& n, Finish&& finish);
     template <class Init, class Update, class Finish, class Empty, class Skip, class Out>
-    void run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish, Empty&& empty, Skip&& skip, Out&& out);
+    void run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish, Empty&& empty, Skip&& skip, Out&& out,
+             bool segments = false);
+    int segment_bounds(Lanes& L, int n);
     bool skip_sphere(Lanes& L, int i, float slo, float te);
     template <class Skip>
     bool jump(Lanes& L, int i, Skip& skip);
