@@ -45,6 +45,14 @@ constexpr size_t kTreeMaxNodes = size_t(1) << 20;
 // 50,709 leaves, 3.5 points a batch; capped at 14,400 nodes it took 0.92x the time,
 // recursive1.sdf 0.90x, vases.sdf 0.94x, showcase.sdf 1.01x).
 constexpr size_t kTreeSamplesPerNode = 16, kTreeMinNodes = 4096;
+// Under a thin layer (its root centred below it, frame.cpp settle_thin_layer) the surface
+// cells are half as many a level, so the same budget would take its leaves a level deeper,
+// into batches too small to fill: one node per 24 samples. Against 16 (and the root centred
+// as before), 2 threads, 5 rounds alternating: the 10,000-sphere grid 0.79x at 640 x 360,
+// 0.86x at 1280 x 720; 1,024 spheres 0.98x; 3,600 spheres (test_accel) 0.95x at 160 x 90,
+// 0.93x at 640 x 360, but 1.08x at 1280 x 720, where the budget does not bind and the
+// taller root's cells give 23,004 leaves instead of 17,880.
+constexpr size_t kTreeThinSamplesPerNode = 24;
 constexpr int kTreeMaxStall = 3;          // splits in a row that did not shorten tapes (x 0.9)
 constexpr float kTreeNear = 0.25f;        // empty cells are split when the surface is this near (x size)
 constexpr size_t kTreeRound = 64;         // cells split in parallel per round
@@ -122,10 +130,10 @@ struct TreeScratch {
 // the work spent against the budget.
 class TreeBuilder {
 public:
-    TreeBuilder(const Program& p, glm::vec3 lo, glm::vec3 hi, float time, bool lipschitz, size_t samples)
+    TreeBuilder(const Program& p, glm::vec3 lo, glm::vec3 hi, float time, bool lipschitz, size_t samples, bool thin_layer)
         : p_(p), time_(time), lipschitz_(lipschitz),
           budget_(kTreeWorkBase + kTreeWorkPerInstr * p.code.size() + kTreeWorkPerSample * samples),
-          max_nodes_(std::clamp(samples / kTreeSamplesPerNode, kTreeMinNodes, kTreeMaxNodes)) {
+          max_nodes_(std::clamp(samples / (thin_layer ? kTreeThinSamplesPerNode : kTreeSamplesPerNode), kTreeMinNodes, kTreeMaxNodes)) {
         cells_[0].lo = lo, cells_[0].hi = hi;
         cells_[0].tape = Tape::from(p, 0);
         cells_[0].tape.mark_min_chains();  // a union's far shapes go against its nearest anywhere
@@ -437,12 +445,13 @@ bool TapeTree::all_empty(const glm::vec3& blo, const glm::vec3& bhi) const {
     return true;
 }
 
-void build_tree(TapeTree& T, const Program& p, glm::vec3 lo, glm::vec3 hi, float time, bool lipschitz, size_t samples) {
+void build_tree(TapeTree& T, const Program& p, glm::vec3 lo, glm::vec3 hi, float time, bool lipschitz, size_t samples,
+                bool thin_layer) {
     T.init_full(p);
     T.lo = lo;
     T.hi = hi;
     T.active = true;
-    TreeBuilder b(p, lo, hi, time, lipschitz, samples);
+    TreeBuilder b(p, lo, hi, time, lipschitz, samples, thin_layer);
     bool worth_it = true;
     while (b.queued()) {
         if (b.pilot_rejects()) {

@@ -135,7 +135,10 @@ struct TapeTree {
 // Builds the tree over [lo, hi] for output 0 of `p` (call inside the render's task arena;
 // see tape_tree.cpp for the order and the budgets). `lipschitz`: `p` is a 1-Lipschitz
 // distance bound (cells' intervals may be tightened with centre values). `samples`: the
-// image's primary rays, which scale the build's work budget.
-void build_tree(TapeTree& T, const Program& p, glm::vec3 lo, glm::vec3 hi, float time, bool lipschitz, size_t samples);
+// image's primary rays, which scale the build's work and node budgets. `thin_layer`: the
+// root was centred under a thin layer of surfaces (frame.hpp tree_root), which takes a
+// smaller node budget.
+void build_tree(TapeTree& T, const Program& p, glm::vec3 lo, glm::vec3 hi, float time, bool lipschitz, size_t samples,
+                bool thin_layer = false);
 
 }  // namespace sdfc::cpu

@@ -159,17 +159,8 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
     arena.execute([&] {
         if (want_tree) {
             const auto t0 = Clock::now();
-            // Under a thin layer the tree's surface cells are half as many a level, so the same
-            // node budget would take its leaves a level deeper, into batches too small to fill:
-            // two thirds of it (one node per 24 samples instead of tape_tree.cpp's 16; the
-            // per-sample share of the build's work budget shrinks with it). Against the root and
-            // budget before, 2 threads, 5 rounds alternating: the 10,000-sphere grid 0.79x at
-            // 640 x 360, 0.86x at 1280 x 720; 1,024 spheres 0.98x; 3,600 spheres (test_accel)
-            // 0.95x at 160 x 90, 0.93x at 640 x 360, but 1.08x at 1280 x 720, where the budget
-            // does not bind and the taller root's cells give 23,004 leaves instead of 17,880.
-            size_t samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(f.samples);
-            if (thin_layer) samples = samples / 3 * 2;
-            cpu::build_tree(f.tree, scene.distance, root_lo, root_hi, f.time, !f.raw, samples);
+            const size_t samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(f.samples);
+            cpu::build_tree(f.tree, scene.distance, root_lo, root_hi, f.time, !f.raw, samples, thin_layer);
             tree_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         }
         f.max_regs = std::max<uint32_t>(f.tree.max_regs, std::max<uint32_t>(scene.distance.num_regs, 1));
