@@ -1,5 +1,5 @@
 // The GLSL renderer, pasted around the scene functions by compiler/glsl/glsl.cpp. Its rules
-// (camera rays, over-relaxed sphere tracing, raw-field bisection, soft shadows, normals,
+// (camera rays, over-relaxed sphere tracing, raw-field refinement, soft shadows, normals,
 // material clamps, Fresnel, Blinn-Phong, AO, clipping, the tile pre-march, sRGB) are
 // compiler/render/rules.h's, the same text the CPU renderer (runtime/cpu/) compiles; what is
 // written here is the shader's scheduling: mirror/glass bounces from an explicit stack (GLSL

@@ -62,7 +62,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
     SdfRay r = SdfRay(O, D, vec3(w0), tmin, tmax, 0.0, 0.0, false, false, 0);
     int mode = SDF_ST_POP;
     // Marching state (camera, bounce, cone and shadow rays).
-    float t = 0.0, om = SDF_RELAX, pr = 0.0, sl = 0.0, prev = -1.0, lo = 0.0, hi = 0.0, bisect = 0.0;
+    float t = 0.0, om = SDF_RELAX, pr = 0.0, sl = 0.0, prev = -1.0, pv = -1.0, hi = 0.0, fhi = 0.0, refine = 0.0;
     int steps = 0;
     // Cone state: the closest approach (a, at b) of the current edge zone, the partial hits.
     float ca = 2.0, cb = 0.0, trans = 1.0;
@@ -111,7 +111,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
                         if (!r.inside) acc += sdf_background * r.w;
                         continue;
                     }
-                    om = SDF_RELAX, pr = 0.0, sl = 0.0, prev = -1.0, lo = 0.0, hi = 0.0, bisect = 0.0;
+                    om = SDF_RELAX, pr = 0.0, sl = 0.0, prev = -1.0, pv = -1.0, hi = 0.0, fhi = 0.0, refine = 0.0;
                     steps = 0;
                     mode = SDF_ST_MARCH;
                     break;
@@ -172,7 +172,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
                 t = a0;
                 sw = light.directional ? light.radius : light.radius / dist;
                 soft = light.radius > 0.0 && !SDF_RAW;
-                om = SDF_RELAX, pr = 0.0, sl = 0.0, res = 1.0, prev = SDF_RAW ? -1.0 : 1e20, lo = 0.0, hi = 0.0, bisect = 0.0;
+                om = SDF_RELAX, pr = 0.0, sl = 0.0, res = 1.0, prev = SDF_RAW ? -1.0 : 1e20, pv = -1.0, hi = 0.0, fhi = 0.0, refine = 0.0;
                 steps = 0;
                 mode = SDF_ST_SHADOW;
                 break;
@@ -197,7 +197,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
             float s = r.inside ? -dist : dist;
             if (SDF_RAW) {
                 done = sdf_raw_step(s, r.t0, r.tmax, false, steps, SDF_MAX_STEPS, SDF_EPSILON, sdf_cam.foot_base, sdf_cam.foot_slope,
-                                    SDF_RAW_INV_LIPSCHITZ, SDF_RAW_MAX_STEP, t, prev, lo, hi, bisect, hit);
+                                    SDF_RAW_INV_LIPSCHITZ, SDF_RAW_MAX_STEP, t, prev, pv, hi, fhi, refine, hit);
             } else {
                 float last;
                 done = sdf_relaxed_step(s, r.t0, r.tmax, false, steps, SDF_MAX_STEPS, SDF_EPSILON, t, om, pr, sl, last);
@@ -326,7 +326,7 @@ vec3 sdf_trace(vec3 O, vec3 D, float w0) {
             bool hit = false, done;
             if (SDF_RAW) {
                 done = sdf_raw_step(dist, path, stmax, true, steps, SDF_MAX_STEPS, SDF_EPSILON, sdf_cam.foot_base, sdf_cam.foot_slope,
-                                    SDF_RAW_INV_LIPSCHITZ, SDF_RAW_MAX_STEP, t, prev, lo, hi, bisect, hit);
+                                    SDF_RAW_INV_LIPSCHITZ, SDF_RAW_MAX_STEP, t, prev, pv, hi, fhi, refine, hit);
             } else if (soft) {
                 done = sdf_soft_step(dist, path, stmax, sw, steps, SDF_MAX_STEPS, SDF_EPSILON, t, res, prev, om, pr, sl);
             } else {

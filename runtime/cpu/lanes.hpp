@@ -34,8 +34,9 @@ static_assert(kWindow % kBatch == 0);
 //                 om, pr, sl as march
 //   cone_march    a = smallest d / r in the current edge zone (>= 1: none);  b = its t;
 //                 w = 1 when the ray ended as a hit
-//   march_raw     a = previous t (< 0: none yet);  b, w = bisection bracket (outside end,
-//                 inside end);  sl = bisection iterations (0 while marching);
+//   march_raw     a = previous t (< 0: none yet), the bracket's outside end while refining;
+//                 pr = the value there (NaN: not evaluated);  w, b = the bracket's inside end
+//                 and its value;  sl = refinements (0 while marching);
 //                 om = 1 when the ray ended as a hit
 //
 // `sign` is +1 for a ray outside solids, -1 inside (it marches on -d).

@@ -21,7 +21,7 @@
 //    recorded as a partial hit of coverage 1 - d/r; up to 4 such layers are composited front
 //    to back, then the final hit (or the background) gets the remaining weight.
 //  * Raw fields (CompiledScene::raw_field, .vm models, no distance bound): see march_raw();
-//    sign-change marching with bisection, hard shadows only, no AO, no cone tracing.
+//    sign-change marching with refinement, hard shadows only, no AO, no cone tracing.
 //  * Tape tree: lanes evaluate their leaf's tape and jump over leaves proven empty
 //    (tape_tree.hpp); each march decides whether a jump is safe for it (its `skip`).
 //
@@ -244,12 +244,15 @@ void Worker::march(const RaySet& rs) {
 }
 
 // Marching a raw field (no distance bound): steps of |f| / L, with L a Lipschitz estimate
-// sampled over the volume (make_frame, frame.cpp), clamped to [one pixel footprint, raw_max_step]; a
-// sign change (f <= 0) is refined by bisection to the outside end of the bracket. Thin features
-// (under a pixel or where the estimate is low) can be missed: the price of no bound. An empty
-// tape-tree leaf is left by the same rule, its lower bound standing for the sample.
-// Lane state: a = previous t, b / w = bisection bracket (lo, hi), sl = bisection iterations
-// (0 while marching), om = 1 when the ray ended as a hit.
+// sampled over the volume (make_frame, frame.cpp), clamped to [one pixel footprint, raw_max_step],
+// or, for camera rays where the field falls, to just past the zero the last two samples'
+// secant predicts (at most twice that step); a sign change (f <= 0) is refined to the outside
+// end of the bracket, on the chord first (rules.h sdf_raw_step). Thin features (under a pixel or
+// two, or where the estimate is low) can be missed: the price of no bound. An empty tape-tree leaf is left by the same rule, its lower bound
+// standing for the sample.
+// Lane state: a = previous t (the bracket's outside end), pr = its value (NaN: unknown),
+// w / b = the bracket's inside end and its value, sl = refinements (0 while marching),
+// om = 1 when the ray ended as a hit.
 // `shadow`: results go to vis_ (0 = blocked) instead of t_ / hit_ / steps_.
 void Worker::march_raw(const RaySet& rs, bool shadow) {
     const size_t n = rs.size();
@@ -264,15 +267,17 @@ void Worker::march_raw(const RaySet& rs, bool shadow) {
     const float inv_l = 1.0f / f_.raw_lipschitz;
     const float foot_base = f_.camera.footprint_base(), foot_slope = f_.camera.footprint_slope();
     run(
-        rs, [](Lanes& L, int i) { L.a[i] = -1.0f, L.sl[i] = 0.0f, L.om[i] = 0.0f; },
+        rs, [](Lanes& L, int i) { L.a[i] = -1.0f, L.pr[i] = NAN, L.sl[i] = 0.0f, L.om[i] = 0.0f; },
         [&](Lanes& L, int m, const float* dist) {
-            // Sign-change marching with bisection (rules.h sdf_raw_step): a = previous t,
-            // b / w = bracket, sl = halvings, om = 1 when the ray ended as a hit.
+            // Sign-change marching with refinement (rules.h sdf_raw_step): a = previous t
+            // (the bracket's outside end), pr = its value, w / b = the inside end and its
+            // value, sl = refinements, om = 1 when the ray ended as a hit.
             for (int i = 0; i < m; ++i) {
                 const int st = ++L.steps[i];
                 bool hit;
                 L.done[i] = rules::sdf_raw_step(L.sign[i] * dist[i], L.t0[i], L.tmax[i], shadow, st, max_steps, f_.eps, foot_base,
-                                                foot_slope, inv_l, f_.raw_max_step, L.t[i], L.a[i], L.b[i], L.w[i], L.sl[i], hit);
+                                                foot_slope, inv_l, f_.raw_max_step, L.t[i], L.a[i], L.pr[i], L.w[i], L.b[i], L.sl[i],
+                                                hit);
                 L.om[i] = hit ? 1.0f : 0.0f;
             }
         },
@@ -294,9 +299,9 @@ void Worker::march_raw(const RaySet& rs, bool shadow) {
             // slo would take (the field is >= slo at the exit, which lies in the leaf), but
             // at least a quarter pixel, for progress; the current point is the outside end
             // of a later bracket.
-            if (L.sl[i] > 0.0f) return false;  // bisecting
+            if (L.sl[i] > 0.0f) return false;  // refining
             const float t = L.t[i], tn = std::max(te, t);
-            L.a[i] = t;
+            L.a[i] = t, L.pr[i] = NAN;  // (not evaluated: no secant from it)
             const float beyond = std::min(slo * inv_l, f_.raw_max_step);
             L.t[i] = tn + std::max(beyond, 0.25f * f_.footprint(L.t0[i] + tn) + 1e-6f * tn);
             return true;
@@ -308,7 +313,7 @@ void Worker::march_raw(const RaySet& rs, bool shadow) {
 // proven positive, the lane can leave the leaf as if it were empty: its leaf's tape over the
 // box around that segment, in interval arithmetic (a segment's box is much smaller than the
 // leaf's, and a ray leaving a surface, or passing one, often clears it). Once per lane and
-// leaf, for lanes not bisecting whose leaves are not empty; by leaf, kIvLanes boxes a call.
+// leaf, for lanes not refining whose leaves are not empty; by leaf, kIvLanes boxes a call.
 // Sets L.seg of the lanes proven and returns them in L.idx[0, return).
 // Only for leaves of at most kSegmentTape instructions: over a long tape (bear.vm's leaves
 // keep 517 of its 525 instructions, exp and log among them) a bound costs more than the

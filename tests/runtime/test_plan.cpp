@@ -121,7 +121,7 @@ TEST_CASE("rules: material fallbacks are the material table's defaults") {
     CHECK(rules::sdf_clamp01(2.0f) == 1.0f);
 }
 
-TEST_CASE("rules: relaxed steps, hits and the raw-field bisection") {
+TEST_CASE("rules: relaxed steps, hits, and the raw field's secant steps and refinement") {
     // Far from anything: an over-relaxed step of 1.5 d.
     float t = 1.0f, om = 1.5f, pr = 0.0f, sl = 0.0f, last = 0.0f;
     CHECK_FALSE(rules::sdf_relaxed_step(2.0f, 0.0f, 100.0f, false, 1, 256, 1e-4f, t, om, pr, sl, last));
@@ -138,13 +138,50 @@ TEST_CASE("rules: relaxed steps, hits and the raw-field bisection") {
     const bool hit = rules::sdf_relaxed_hit(last2, t2, 3, 256, 1e-4f, 0.0f, 1e-3f);
     CHECK(hit);
     CHECK(rules::sdf_hit_t(t2, last2, hit) == 3.0f + 1e-5f);
-    // Raw field: a sign change brackets, bisection ends at the outside end.
-    float rt = 1.0f, prev = 0.5f, lo = 0.0f, hi = 0.0f, bisect = 0.0f;
+    // Raw field: a sign change brackets [prev, t]; without the value at prev, it is halved.
+    float rt = 1.0f, prev = 0.5f, pv = NAN, hi = 0.0f, fhi = 0.0f, refine = 0.0f;
     bool rhit = false;
-    CHECK_FALSE(rules::sdf_raw_step(-1.0f, 0.0f, 10.0f, false, 1, 256, 1e-4f, 0.0f, 1e-3f, 1.0f, 1.0f, rt, prev, lo, hi, bisect, rhit));
-    CHECK(lo == 0.5f);
+    CHECK_FALSE(
+        rules::sdf_raw_step(-1.0f, 0.0f, 10.0f, false, 1, 256, 1e-4f, 0.0f, 1e-3f, 1.0f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
+    CHECK(prev == 0.5f);
     CHECK(hi == 1.0f);
+    CHECK(fhi == -1.0f);
+    CHECK(refine == 1.0f);
     CHECK(rt == 0.75f);
+    // With it, the chord's zero (0.875 for values 3 and -1), then 0.45 thresholds toward
+    // the end farther from it (prev).
+    rt = 1.0f, prev = 0.5f, pv = 3.0f, refine = 0.0f;
+    CHECK_FALSE(
+        rules::sdf_raw_step(-1.0f, 0.0f, 10.0f, false, 1, 256, 1e-4f, 0.0f, 1e-3f, 1.0f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
+    CHECK(rt == Approx(0.875f - 0.45e-4f).epsilon(1e-6));
+    // Positive there: the bracket is [rt, 1], over a threshold wide: the next probe. Then
+    // negative within a threshold of it: a hit at the outside end.
+    const float probe = rt;
+    CHECK_FALSE(
+        rules::sdf_raw_step(0.1f, 0.0f, 10.0f, false, 2, 256, 1e-4f, 0.0f, 1e-3f, 1.0f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
+    CHECK(prev == probe);
+    rt = probe + 0.5e-4f;
+    CHECK(rules::sdf_raw_step(-0.1f, 0.0f, 10.0f, false, 3, 256, 1e-4f, 0.0f, 1e-3f, 1.0f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
+    CHECK(rhit);
+    CHECK(rt == probe);
+    // Marching: a footprint-sized step (|f| / L under a footprint) where the secant of the last
+    // two samples (1 at 0, 0.5 at 0.5) puts the zero 0.5 ahead: 2 footprints instead of 1.
+    rt = 0.5f, prev = 0.0f, pv = 1.0f, refine = 0.0f;
+    CHECK_FALSE(
+        rules::sdf_raw_step(0.5f, 0.0f, 10.0f, false, 2, 256, 1e-4f, 0.0f, 1e-3f, 1e-3f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
+    CHECK(prev == 0.5f);
+    CHECK(pv == 0.5f);
+    CHECK(rt == Approx(0.5f + 2.0f * 0.5e-3f).epsilon(1e-6));
+    // A shadow ray (any sign change ends it) keeps the footprint.
+    rt = 0.5f, prev = 0.0f, pv = 1.0f, refine = 0.0f;
+    CHECK_FALSE(
+        rules::sdf_raw_step(0.5f, 0.0f, 10.0f, true, 2, 256, 1e-4f, 0.0f, 1e-3f, 1e-3f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
+    CHECK(rt == Approx(0.5f + 0.5e-3f).epsilon(1e-6));
+    // Rising: no secant, one footprint.
+    rt = 0.5f, prev = 0.0f, pv = 0.25f, refine = 0.0f;
+    CHECK_FALSE(
+        rules::sdf_raw_step(0.5f, 0.0f, 10.0f, false, 2, 256, 1e-4f, 0.0f, 1e-3f, 1e-3f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
+    CHECK(rt == Approx(0.5f + 0.5e-3f).epsilon(1e-6));
     CHECK(rules::sdf_to_srgb(0.0031308f) == Approx(0.04045f).epsilon(1e-3));
     CHECK(rules::sdf_to_srgb(2.0f) == 1.0f);
     CHECK(rules::sdf_grid_x(0, 5) == -1.0f);
