@@ -172,11 +172,16 @@ TEST_CASE("rules: relaxed steps, hits, and the raw field's secant steps and refi
     CHECK(prev == 0.5f);
     CHECK(pv == 0.5f);
     CHECK(rt == Approx(0.5f + 2.0f * 0.5e-3f).epsilon(1e-6));
-    // A shadow ray (any sign change ends it) keeps the footprint.
+    // A shadow ray (any sign change ends it) keeps the footprint where the field falls, and
+    // takes two where it rises.
     rt = 0.5f, prev = 0.0f, pv = 1.0f, refine = 0.0f;
     CHECK_FALSE(
         rules::sdf_raw_step(0.5f, 0.0f, 10.0f, true, 2, 256, 1e-4f, 0.0f, 1e-3f, 1e-3f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
     CHECK(rt == Approx(0.5f + 0.5e-3f).epsilon(1e-6));
+    rt = 0.5f, prev = 0.0f, pv = 0.25f, refine = 0.0f;
+    CHECK_FALSE(
+        rules::sdf_raw_step(0.5f, 0.0f, 10.0f, true, 2, 256, 1e-4f, 0.0f, 1e-3f, 1e-3f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
+    CHECK(rt == Approx(0.5f + 2.0f * 0.5e-3f).epsilon(1e-6));
     // Rising: no secant, one footprint.
     rt = 0.5f, prev = 0.0f, pv = 0.25f, refine = 0.0f;
     CHECK_FALSE(
