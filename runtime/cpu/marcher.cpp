@@ -244,13 +244,13 @@ void Worker::march(const RaySet& rs) {
 }
 
 // Marching a raw field (no distance bound): steps of |f| / L, with L a Lipschitz estimate
-// sampled over the volume (make_frame, frame.cpp), clamped to [one pixel footprint, raw_max_step],
-// or, for camera rays where the field falls, to just past the zero the last two samples'
-// secant predicts (at most twice that step), and twice that step for shadow rays where it
-// rises; a sign change (f <= 0) is refined to the outside
-// end of the bracket, on the chord first (rules.h sdf_raw_step). Thin features (under a pixel or
-// two, or where the estimate is low) can be missed: the price of no bound. An empty tape-tree leaf is left by the same rule, its lower bound
-// standing for the sample.
+// sampled over the volume (make_frame, frame.cpp), clamped to [one pixel footprint,
+// raw_max_step], or, for camera rays where the field falls, to just past the zero the last
+// two samples' secant predicts (at most twice that step), and twice that step for shadow rays
+// where it rises; a sign change (f <= 0) is refined to the outside end of the bracket, on the
+// chord first (rules.h sdf_raw_step). Thin features (under a step or two, or where the
+// estimate is low) can be missed: the price of no bound. An empty tape-tree leaf is left by
+// the same rule, its lower bound standing for the sample.
 // Lane state: a = previous t (the bracket's outside end), pr = its value (NaN: unknown),
 // w / b = the bracket's inside end and its value, sl = refinements (0 while marching),
 // om = 1 when the ray ended as a hit.
