@@ -48,11 +48,7 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             if (const BuiltinInfo* bi = find_builtin(e.text)) {
                 Value v;
                 v.t = VT::Function;
-                auto fn = std::make_shared<Callable>();
-                fn->name = bi->name;
-                fn->builtin = true;
-                fn->id = bi->id;
-                v.fn = fn;
+                v.fn = builtin_callable(bi->id);
                 return v;
             }
             if (failed_lets.count(e.text)) throw CompileError(std::vector<Diagnostic>{});  // its error is out already

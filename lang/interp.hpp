@@ -77,6 +77,8 @@ struct BuiltinInfo {
 };
 
 const BuiltinInfo* find_builtin(std::string_view name);
+// The function value of a builtin (one, shared: Callable is immutable).
+const std::shared_ptr<const Callable>& builtin_callable(Builtin id);
 const BuiltinInfo& builtin_info(Builtin id);
 const std::vector<std::string>& builtin_names();
 
