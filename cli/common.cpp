@@ -60,10 +60,11 @@ std::string one_scene(Args& a, const char* cmd) {
 namespace {
 std::set<std::string> g_warned;  // each warning once (a scene compiles once per frame)
 
-// The last build's Scene is kept until the next build or the process's end: its teardown
-// (the interpreter's state, the syntax tree, the shapes) is work the exit makes moot, 8 % of
-// a 10,000-statement check. Freed before the next build, so an animation's frames or watch's
-// rebuilds never hold two. Reachable from here, so leak checkers do not count it.
+// With Common::keep_scene, the last build's Scene is kept until the next build or the
+// process's end: its teardown (the interpreter's state, the syntax tree, the shapes) is work
+// the exit makes moot, 8 % of a 10,000-statement check. Freed before the next build, so
+// watch's rebuilds never hold two. Reachable from here, so leak checkers do not count it.
+// Not for commands that render: they would hold it through the render.
 std::mutex g_kept_mutex;
 Scene* g_kept = nullptr;
 
@@ -96,7 +97,7 @@ CompiledScene build(SourceManager& sm, const std::string& path, Common& c, std::
     print_warnings(s);
     CompiledScene cs = compile_scene(s);
     check_field_finite(s, cs);
-    keep_until_next_build(std::move(s));
+    if (c.keep_scene) keep_until_next_build(std::move(s));
     return cs;
 }
 

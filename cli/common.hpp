@@ -18,6 +18,9 @@ struct Common {
     InterpretOptions interp;
     long max_pixels = 268'435'456;  // width * height * samples
     int max_frames = 100000;
+    // build() leaves the Scene to the process's exit (or the next build) instead of freeing
+    // it: for commands that do little after the build (check), whose time its teardown is.
+    bool keep_scene = false;
 };
 
 // The safety-limit flags (--max-*), taken out of the arguments.

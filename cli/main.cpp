@@ -370,6 +370,7 @@ int cmd_render(Args& a) {
 
 int cmd_check(Args& a) {
     Common c = read_common(a);
+    c.keep_scene = true;
     std::string path = one_scene(a, "check");
     SourceManager sm;
     build(sm, path, c, 0.0f);
