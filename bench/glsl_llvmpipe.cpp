@@ -2,7 +2,10 @@
 // llvmpipe (the CPU "GPU") through headless EGL: surfaceless platform, GLES 3.0, an RGBA8
 // FBO, one full-screen triangle; each draw is timed to glFinish, after one warm-up draw
 // (shader JIT). llvmpipe's thread count is LP_NUM_THREADS (set here from THREADS).
-//   sdfc_llvmpipe SHADER.glsl W H [THREADS=2] [REPEAT=5]   prints `median_ms=… min_ms=… renderer=…`
+// With SDFC_GL=device the same draws go to the first EGL device (a real GPU driver, e.g.
+// NVIDIA's, headless through EGL_EXT_platform_device) and THREADS is ignored.
+//   sdfc_llvmpipe SHADER.glsl W H [THREADS=2] [REPEAT=5]
+// prints `median_ms=… min_ms=… first_ms=… renderer=…` (first_ms: compile, link and first draw).
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 #include <GLES3/gl3.h>
@@ -45,6 +48,16 @@ int fail(const char* what) {
     return 1;
 }
 
+// The first device EGL enumerates: how a GPU driver renders without a window system.
+EGLDisplay device_display() {
+    auto query = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+    if (!query) return eglGetDisplay(EGL_DEFAULT_DISPLAY);
+    EGLDeviceEXT devices[8];
+    EGLint n = 0;
+    if (!query(8, devices, &n) || n < 1) return eglGetDisplay(EGL_DEFAULT_DISPLAY);
+    return eglGetPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, devices[0], nullptr);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -58,12 +71,19 @@ int main(int argc, char** argv) {
     const int w = std::atoi(argv[2]), h = std::atoi(argv[3]);
     const int threads = argc > 4 ? std::atoi(argv[4]) : 2;
     const int repeat = argc > 5 ? std::max(1, std::atoi(argv[5])) : 5;
-    setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
-    setenv("GALLIUM_DRIVER", "llvmpipe", 1);
-    setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 1);
-
-    EGLDisplay dpy = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-    if (dpy == EGL_NO_DISPLAY) return fail("eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA)");
+    const char* mode = std::getenv("SDFC_GL");
+    const bool device = mode && std::string(mode) == "device";
+    EGLDisplay dpy = EGL_NO_DISPLAY;
+    if (device) {
+        dpy = device_display();
+        if (dpy == EGL_NO_DISPLAY) return fail("no EGL device (EGL_EXT_device_enumeration)");
+    } else {
+        setenv("LIBGL_ALWAYS_SOFTWARE", "1", 1);
+        setenv("GALLIUM_DRIVER", "llvmpipe", 1);
+        setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), 1);
+        dpy = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+        if (dpy == EGL_NO_DISPLAY) return fail("eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA)");
+    }
     EGLint major = 0, minor = 0;
     if (!eglInitialize(dpy, &major, &minor)) return fail("eglInitialize");
     if (!eglBindAPI(EGL_OPENGL_ES_API)) return fail("eglBindAPI");
@@ -89,6 +109,7 @@ int main(int argc, char** argv) {
     glGenVertexArrays(1, &vao);
     glBindVertexArray(vao);
 
+    const auto t_first = std::chrono::steady_clock::now();
     const std::string frag = "#version 300 es\nprecision highp float;\nprecision highp int;\n"
                              "uniform vec3 iResolution;\nuniform float iTime;\nuniform vec4 iMouse;\nout vec4 sdf_out;\n" +
                              ss.str() + "\nvoid main() { mainImage(sdf_out, gl_FragCoord.xy); }\n";
@@ -99,22 +120,27 @@ int main(int argc, char** argv) {
     GLint ok = 0;
     glGetProgramiv(prog, GL_LINK_STATUS, &ok);
     if (!ok) return fail("link");
+    std::fprintf(stderr, "linked_ms=%.1f\n",
+                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_first).count());
     glUseProgram(prog);
     glUniform3f(glGetUniformLocation(prog, "iResolution"), float(w), float(h), 1.0f);
     glUniform1f(glGetUniformLocation(prog, "iTime"), 0.0f);
     glUniform4f(glGetUniformLocation(prog, "iMouse"), 0.0f, 0.0f, 0.0f, 0.0f);
     glViewport(0, 0, w, h);
     std::vector<double> ms;
+    double first_ms = 0;
     for (int r = 0; r <= repeat; ++r) {
         const auto t0 = std::chrono::steady_clock::now();
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glFinish();
-        const double t = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-        if (r > 0) ms.push_back(t);  // the first draw compiles the shader
+        const auto t1 = std::chrono::steady_clock::now();
+        if (r > 0) ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+        else first_ms = std::chrono::duration<double, std::milli>(t1 - t_first).count();  // the first draw compiles
     }
     std::sort(ms.begin(), ms.end());
     const char* rn = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    std::printf("median_ms=%.2f min_ms=%.2f renderer=%s\n", ms[ms.size() / 2], ms.front(), rn ? rn : "?");
+    std::printf("median_ms=%.3f min_ms=%.3f first_ms=%.1f renderer=%s\n", ms[ms.size() / 2], ms.front(), first_ms,
+                rn ? rn : "?");
     eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(dpy, ctx);
     eglTerminate(dpy);

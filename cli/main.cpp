@@ -525,7 +525,13 @@ int cmd_glsl(Args& a) {
     if (out) check_not_input(*out, sm);
     Args flags = flat_args(ov);
     apply_render_flags(s.render, flags);
-    std::string text = compile_glsl(s, t, go).text;
+    GlslOutput g = compile_glsl(s, t, go);
+    if (g.tape && g.tape_texels > kNvidiaConstArrayTexels && (t == GlslTarget::Shadertoy || t == GlslTarget::Glsl330))
+        std::fprintf(stderr,
+                     "sdfc: warning: the scene's tape is one constant array of %zu uvec4s: NVIDIA's GLSL compiler takes at most "
+                     "%zu (error C1068: too much data in type constructor); --target html keeps the tape in a texture\n",
+                     g.tape_texels, kNvidiaConstArrayTexels);
+    std::string text = std::move(g.text);
     if (!out) {
         write_stdout(text);
         return 0;

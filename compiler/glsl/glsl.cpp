@@ -63,6 +63,7 @@ struct Parts {
     bool uses_time = false;
     bool tape = false;
     std::vector<uint32_t> tape_words;
+    size_t tape_texels = 0;  // uvec4s of the tape
     size_t instructions = 0;
     int samples = 1, max_steps = 256, max_bounces = 3;  // the knobs (knob_block)
     std::vector<SceneParam> params;                    // the script's params (sdf_param[i])
@@ -215,6 +216,7 @@ Parts generate(const Scene& scene, const GlslOptions& options, glsl::TapeStorage
             mat.code.size(), sm.begin, sm.end);
         for (const std::string& line : material_return(o)) c += "    " + line + "\n";
         c += "}\n";
+        out.tape_texels = t.words.size() / 4;
         if (storage == glsl::TapeStorage::Texture) out.tape_words = t.words;
     } else {
         fs.signature = "float map(vec3 p)";
@@ -394,6 +396,7 @@ GlslOutput compile_glsl(const Scene& scene, GlslTarget target, const GlslOptions
     out.text = target_text(p, target);
     out.uses_time = p.uses_time;
     out.tape = p.tape;
+    out.tape_texels = p.tape_texels;
     out.instructions = p.instructions;
     out.samples = p.samples;
     out.max_steps = p.max_steps;

@@ -22,6 +22,9 @@ enum class GlslTarget {
 // the tape for programs of kTapeThreshold instructions or more.
 enum class GlslCode { Auto, Straight, Tape };
 inline constexpr size_t kTapeThreshold = 10000;  // distance + shading instructions (the measurements: docs/architecture.md)
+// The most uvec4s NVIDIA's GLSL compiler (driver 580) takes in one array constructor: 2,048
+// fail with "error C1068: too much data in type constructor" (measured on an H200).
+inline constexpr size_t kNvidiaConstArrayTexels = 1024;
 
 struct GlslOptions {
     GlslCode code = GlslCode::Auto;
@@ -34,6 +37,7 @@ struct GlslOutput {
     std::string text;                  // the shader, or the page for Html
     bool uses_time = false;            // the shader depends on iTime
     bool tape = false;                 // the programs are a tape
+    size_t tape_texels = 0;            // its uvec4s (Shadertoy and GLSL 330: one constant array of them)
     std::vector<uint32_t> tape_words;  // HtmlShader with a tape: the words of its sdf_tape texture
     size_t instructions = 0;           // of the distance and shading programs
     int samples = 1, max_steps = 256, max_bounces = 3;  // the knobs' values for the script (Html: their uniforms)

@@ -34,3 +34,21 @@ TEST_CASE("warnings for one-operand CSG, an empty difference and an ignored alph
     for (size_t at = frames.err.find("warning: this intersection"); at != std::string::npos; at = frames.err.find("warning: this intersection", at + 1)) ++n;
     CHECK(n == 1);
 }
+
+// Measured on NVIDIA's driver (580, an H200): an array constructor of more than 1,024 uvec4s
+// fails to compile, so a Shadertoy or GLSL 330 shader whose tape is bigger says so.
+TEST_CASE("glsl warns when a tape is too big for NVIDIA's constant arrays, and only then") {
+    const std::string s = test::write_temp("many.sdf", "for (i = [0 : 999]) translate([i % 40, 0, floor(i / 40)]) sphere(0.4);\n");
+    const std::string out = test::temp_dir() + "/many.glsl";
+    for (const char* target : {"shadertoy", "glsl330"}) {
+        auto r = run_sdfc("glsl " + q(s) + " --code tape --target " + target + " -o " + q(out));
+        CHECK(r.status == 0);
+        CHECK(r.err.rfind("sdfc: warning: the scene's tape is one constant array of ", 0) == 0);
+        CHECK(r.err.find(" uvec4s: NVIDIA's GLSL compiler takes at most 1024 (error C1068: too much data in type constructor); "
+                         "--target html keeps the tape in a texture\n") != std::string::npos);
+    }
+    CHECK(run_sdfc("glsl " + q(s) + " --code tape --target html -o " + q(test::temp_dir() + "/many.html")).err.empty());
+    CHECK(run_sdfc("glsl " + q(s) + " --code straight -o " + q(out)).err.empty());
+    const std::string one = test::write_temp("one.sdf", "sphere(1);\n");
+    CHECK(run_sdfc("glsl " + q(one) + " --code tape -o " + q(out)).err.empty());
+}
