@@ -22,6 +22,7 @@
 #include "cli/output_checks.hpp"
 #include "compiler/bytecode/compile.hpp"
 #include "compiler/glsl/glsl.hpp"
+#include "compiler/glsl/glsl_tape.hpp"
 #include "compiler/scene/lower.hpp"
 #include "lang/ast.hpp"
 #include "lang/load.hpp"
@@ -490,11 +491,23 @@ int cmd_slice(Args& a) {
     return 0;
 }
 
+// The tape's words as the texture's data: little-endian uint32, whole rows of
+// glsl::kTapeTextureWidth texels (the last padded with zeros), as the shader's header says.
+static std::string tape_texture_bytes(const std::vector<uint32_t>& words) {
+    const size_t row = size_t(glsl::kTapeTextureWidth) * 4;
+    const size_t n = std::max<size_t>(1, (words.size() + row - 1) / row) * row;
+    std::string b(n * 4, '\0');
+    for (size_t i = 0; i < words.size(); ++i)
+        for (int k = 0; k < 4; ++k) b[4 * i + size_t(k)] = char((words[i] >> (8 * k)) & 0xFFu);
+    return b;
+}
+
 int cmd_glsl(Args& a) {
     Common c = read_common(a);
     auto target = a.value("--target");
     auto out = a.value("-o", "--output");
     auto code = a.value("--code");
+    auto tape_file = a.value("--tape-file");
     Overrides ov;
     for (const char* f : kGlslFlags) ov.emplace_back(f, a.value(f));
     std::string path = one_scene(a, "glsl");
@@ -513,9 +526,23 @@ int cmd_glsl(Args& a) {
         else if (*target == "html") t = GlslTarget::Html;
         else throw UsageError(fmt::format("--target takes shadertoy, glsl330 or html, not '{}'", *target));
     }
+    if (tape_file) {
+        if (t != GlslTarget::Glsl330) throw UsageError("--tape-file is for --target glsl330 (Shadertoy cannot load a file; the html page holds its tape)");
+        if (go.code == GlslCode::Straight) throw UsageError("--tape-file writes a tape: it does not go with --code straight");
+        go.code = GlslCode::Tape;
+        go.tape_texture = true;
+        resolve_output(*tape_file);
+        check_not_input(*tape_file, path);
+    }
     if (out) {
         resolve_output(*out);
         check_not_input(*out, path);
+    }
+    if (tape_file) {
+        const bool same = *tape_file == "-" ? !out || *out == "-"
+                                            : out && *out != "-" &&
+                                                  std::filesystem::weakly_canonical(*out) == std::filesystem::weakly_canonical(*tape_file);
+        if (same) throw UsageError(fmt::format("--tape-file and the shader would both go to '{}'", *tape_file));
     }
     SourceManager sm;
     InterpretOptions o = c.interp;
@@ -523,14 +550,18 @@ int cmd_glsl(Args& a) {
     Scene s = load_scene(sm, path, o);
     print_warnings(s);
     if (out) check_not_input(*out, sm);
+    if (tape_file) check_not_input(*tape_file, sm);
     Args flags = flat_args(ov);
     apply_render_flags(s.render, flags);
     GlslOutput g = compile_glsl(s, t, go);
-    if (g.tape && g.tape_texels > kNvidiaConstArrayTexels && (t == GlslTarget::Shadertoy || t == GlslTarget::Glsl330))
+    if (g.tape && g.tape_texels > kNvidiaConstArrayTexels && !go.tape_texture &&
+        (t == GlslTarget::Shadertoy || t == GlslTarget::Glsl330))
         std::fprintf(stderr,
                      "sdfc: warning: the scene's tape is one constant array of %zu uvec4s: NVIDIA's GLSL compiler takes at most "
-                     "%zu (error C1068: too much data in type constructor); --target html keeps the tape in a texture\n",
+                     "%zu (error C1068: too much data in type constructor); --target html (or glsl330 with --tape-file) keeps "
+                     "the tape in a texture\n",
                      g.tape_texels, kNvidiaConstArrayTexels);
+    if (tape_file) write_file(*tape_file, tape_texture_bytes(g.tape_words));  // before the shader that reads it
     std::string text = std::move(g.text);
     if (!out) {
         write_stdout(text);

@@ -98,6 +98,10 @@ std::vector<CommandSpec> make_commands() {
                       fmt::format("straight: a GLSL statement per instruction; tape: the programs as data for a small interpreter "
                                   "(the shader's code does not grow with the scene); auto: tape from {} instructions",
                                   kTapeThreshold)},
+                     {"--tape-file", "", "PATH", "FILE", "",
+                      "glsl330 only: the programs as a tape (as --code tape) that the shader reads from a texture, "
+                      "uniform usampler2D sdf_tape, whose data is written to PATH (RGBA32UI, 1024 texels a row, little-endian "
+                      "uint32); for big scenes, since NVIDIA's compiler refuses constant arrays over 1,024 texels"},
                  }, glsl_settings()),
                  "The settings flags override the script's render(...); --samples, --max-steps and --max-bounces set the "
                  "#defines at the top of a pasted shader (the html page's controls start from them).",

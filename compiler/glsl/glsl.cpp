@@ -330,6 +330,8 @@ std::string knob_block(const Parts& p, GlslTarget target) {
 
 namespace {
 
+size_t tape_rows(size_t words) { return std::max<size_t>(1, (words / 4 + glsl::kTapeTextureWidth - 1) / glsl::kTapeTextureWidth); }
+
 std::string target_text(const Parts& p, GlslTarget target) {
     switch (target) {
         case GlslTarget::Shadertoy: {
@@ -357,6 +359,12 @@ std::string target_text(const Parts& p, GlslTarget target) {
                         "// fragColor is display-ready (sRGB-encoded) colour; write it to an 8-bit framebuffer\n"
                         "// without GL_FRAMEBUFFER_SRGB.\n\n");
             // Shadertoy's names (LANGUAGE.md: `time` becomes iTime in GLSL).
+            if (!p.tape_words.empty())
+                s += fmt::format(
+                    "// The scene's programs are a tape in a texture: upload the words of `sdfc glsl --tape-file`\n"
+                    "// (little-endian uint32, {} texels) as an RGBA32UI texture {} texels wide and {} high\n"
+                    "// (GL_RGBA_INTEGER, GL_UNSIGNED_INT, GL_NEAREST filters) and bind it to sdf_tape.\n\n",
+                    p.tape_words.size() / 4, glsl::kTapeTextureWidth, tape_rows(p.tape_words.size()));
             s += "uniform vec2 iResolution;\nuniform float iTime;\nuniform vec4 iMouse;\nout vec4 fragColor;\n\n";
             s += knob_block(p, target);
             s += p.code;
@@ -391,7 +399,8 @@ std::string target_text(const Parts& p, GlslTarget target) {
 GlslOutput compile_glsl(const Scene& scene, GlslTarget target, const GlslOptions& options) {
     if (!scene.graph || !scene.root) throw CompileError(Loc{}, "internal: the scene has no graph");
     const bool page = target == GlslTarget::Html || target == GlslTarget::HtmlShader;
-    Parts p = generate(scene, options, page ? glsl::TapeStorage::Texture : glsl::TapeStorage::ConstArray);
+    const bool texture = page || (target == GlslTarget::Glsl330 && options.tape_texture);
+    Parts p = generate(scene, options, texture ? glsl::TapeStorage::Texture : glsl::TapeStorage::ConstArray);
     GlslOutput out;
     out.text = target_text(p, target);
     out.uses_time = p.uses_time;
@@ -402,7 +411,7 @@ GlslOutput compile_glsl(const Scene& scene, GlslTarget target, const GlslOptions
     out.max_steps = p.max_steps;
     out.max_bounces = p.max_bounces;
     out.scene_json = scene_json(p);
-    if (target == GlslTarget::HtmlShader) out.tape_words = std::move(p.tape_words);
+    if (target == GlslTarget::HtmlShader || target == GlslTarget::Glsl330) out.tape_words = std::move(p.tape_words);
     return out;
 }
 

@@ -28,6 +28,11 @@ inline constexpr size_t kNvidiaConstArrayTexels = 1024;
 
 struct GlslOptions {
     GlslCode code = GlslCode::Auto;
+    // Glsl330 with a tape: the tape in `uniform usampler2D sdf_tape` (RGBA32UI,
+    // glsl::kTapeTextureWidth texels a row) instead of a constant array, its words in
+    // GlslOutput::tape_words for the host to upload (sdfc glsl --tape-file). NVIDIA's compiler
+    // refuses constant arrays over kNvidiaConstArrayTexels.
+    bool tape_texture = false;
     // Evaluates the distance program for the raw-field Lipschitz estimate (the runtime's
     // sample_batch is the fast one; the result is the same).
     FieldSampler sample = sample_scalar;
@@ -38,7 +43,7 @@ struct GlslOutput {
     bool uses_time = false;            // the shader depends on iTime
     bool tape = false;                 // the programs are a tape
     size_t tape_texels = 0;            // its uvec4s (Shadertoy and GLSL 330: one constant array of them)
-    std::vector<uint32_t> tape_words;  // HtmlShader with a tape: the words of its sdf_tape texture
+    std::vector<uint32_t> tape_words;  // HtmlShader, or Glsl330 with tape_texture: the words of its sdf_tape texture
     size_t instructions = 0;           // of the distance and shading programs
     int samples = 1, max_steps = 256, max_bounces = 3;  // the knobs' values for the script (Html: their uniforms)
     std::string scene_json;            // what the html page reads besides the shader (time, knobs, parameters)

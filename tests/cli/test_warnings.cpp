@@ -45,10 +45,47 @@ TEST_CASE("glsl warns when a tape is too big for NVIDIA's constant arrays, and o
         CHECK(r.status == 0);
         CHECK(r.err.rfind("sdfc: warning: the scene's tape is one constant array of ", 0) == 0);
         CHECK(r.err.find(" uvec4s: NVIDIA's GLSL compiler takes at most 1024 (error C1068: too much data in type constructor); "
-                         "--target html keeps the tape in a texture\n") != std::string::npos);
+                         "--target html (or glsl330 with --tape-file) keeps the tape in a texture\n") != std::string::npos);
     }
     CHECK(run_sdfc("glsl " + q(s) + " --code tape --target html -o " + q(test::temp_dir() + "/many.html")).err.empty());
     CHECK(run_sdfc("glsl " + q(s) + " --code straight -o " + q(out)).err.empty());
     const std::string one = test::write_temp("one.sdf", "sphere(1);\n");
     CHECK(run_sdfc("glsl " + q(one) + " --code tape -o " + q(out)).err.empty());
+}
+
+// glsl330 --tape-file: the tape as the texture's data, whole rows of 1024 RGBA32UI texels,
+// little-endian; no warning; only with glsl330 and a tape.
+TEST_CASE("glsl330 --tape-file writes the tape for a texture, and refuses what cannot work") {
+    const std::string s = test::write_temp("many_tex.sdf", "for (i = [0 : 999]) translate([i % 40, 0, floor(i / 40)]) sphere(0.4);\n");
+    const std::string out = test::temp_dir() + "/many_tex.glsl", tape = test::temp_dir() + "/many_tex.tape";
+    std::remove(tape.c_str());
+    auto r = run_sdfc("glsl " + q(s) + " --target glsl330 --tape-file " + q(tape) + " -o " + q(out));
+    CHECK(r.status == 0);
+    CHECK(r.err.empty());
+    const std::string shader = test::slurp(out), bytes = test::slurp(tape);
+    CHECK(shader.find("uniform highp usampler2D sdf_tape;") != std::string::npos);
+    CHECK(shader.find("const uvec4 SDF_TAPE") == std::string::npos);
+    // The header names the texels; the file holds whole rows of them, zero-padded.
+    const size_t at = shader.find("(little-endian uint32, ");
+    REQUIRE(at != std::string::npos);
+    const size_t texels = std::stoul(shader.substr(at + 23));
+    CHECK(texels > 1024);
+    CHECK(bytes.size() == (texels + 1023) / 1024 * 1024 * 16);
+    REQUIRE(bytes.size() >= texels * 16);
+    CHECK(bytes.find_first_not_of('\0') < 16);  // the first texel holds an instruction
+    CHECK(bytes.find_first_not_of('\0', texels * 16) == std::string::npos);
+    auto bad = run_sdfc("glsl " + q(s) + " --tape-file " + q(tape) + " -o " + q(out));
+    CHECK(bad.status == 2);
+    CHECK(bad.err == "sdfc: error: --tape-file is for --target glsl330 (Shadertoy cannot load a file; the html page holds its tape)\n");
+    bad = run_sdfc("glsl " + q(s) + " --target glsl330 --code straight --tape-file " + q(tape) + " -o " + q(out));
+    CHECK(bad.status == 2);
+    CHECK(bad.err == "sdfc: error: --tape-file writes a tape: it does not go with --code straight\n");
+    bad = run_sdfc("glsl " + q(s) + " --target glsl330 --tape-file " + q(out) + " -o " + q(out));
+    CHECK(bad.status == 2);
+    CHECK(bad.err == "sdfc: error: --tape-file and the shader would both go to '" + out + "'\n");
+    bad = run_sdfc("glsl " + q(s) + " --target glsl330 --tape-file -");
+    CHECK(bad.status == 2);
+    CHECK(bad.err == "sdfc: error: --tape-file and the shader would both go to '-'\n");
+    bad = run_sdfc("glsl " + q(s) + " --target glsl330 --tape-file " + q(test::temp_dir() + "/no/such/dir/t.tape") + " -o " + q(out));
+    CHECK(bad.status != 0);
 }

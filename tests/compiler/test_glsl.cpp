@@ -548,3 +548,36 @@ TEST_CASE("glsl: big scenes become a tape with bounded code", "[glsl][tape]") {
         CHECK(e == "");
     }
 }
+
+// GLSL 330 with --tape-file: the tape in a texture (NVIDIA refuses constant arrays over
+// kNvidiaConstArrayTexels), the same words and the same interpreter as the html page's.
+TEST_CASE("glsl: glsl330 can read its tape from a texture, the html page's words", "[glsl][tape]") {
+    const std::string src = read_text(fs::path(SDFC_SOURCE_DIR) / "tests/gpu/scenes/big/tree-2047.sdf");
+    REQUIRE(!src.empty());
+    SourceManager sm;
+    InterpretOptions o;
+    o.time = std::nullopt;
+    Scene s = interpret_source(sm, sm.add("tree.sdf", src), o);
+    GlslOptions go;
+    go.tape_texture = true;
+    const GlslOutput g = compile_glsl(s, GlslTarget::Glsl330, go);
+    const GlslOutput page = compile_glsl(s, GlslTarget::HtmlShader);
+    REQUIRE(g.tape);
+    CHECK(g.tape_texels > kNvidiaConstArrayTexels);
+    CHECK(g.tape_words.size() == 4 * g.tape_texels);
+    CHECK(g.tape_words == page.tape_words);
+    CHECK(g.text.find("const uvec4 SDF_TAPE") == std::string::npos);
+    CHECK(g.text.find("uniform highp usampler2D sdf_tape;  // RGBA32UI, 1024 texels a row\n"
+                      "uvec4 sdf_texel(int i) { return texelFetch(sdf_tape, ivec2(i % 1024, i / 1024), 0); }") != std::string::npos);
+    const size_t rows = (g.tape_texels + 1023) / 1024;
+    CHECK(g.text.find("(little-endian uint32, " + std::to_string(g.tape_texels) + " texels) as an RGBA32UI texture 1024 texels wide and " +
+                      std::to_string(rows) + " high") != std::string::npos);
+    // Without the option, GLSL 330 keeps the constant array and no words.
+    const GlslOutput plain = compile_glsl(s, GlslTarget::Glsl330);
+    CHECK(plain.text.find("const uvec4 SDF_TAPE[") != std::string::npos);
+    CHECK(plain.tape_words.empty());
+    if (skip_without_validator()) return;
+    const std::string e = validate(g.text, "tree.glsl330");
+    INFO(e);
+    CHECK(e == "");
+}
