@@ -491,17 +491,6 @@ int cmd_slice(Args& a) {
     return 0;
 }
 
-// The tape's words as the texture's data: little-endian uint32, whole rows of
-// glsl::kTapeTextureWidth texels (the last padded with zeros), as the shader's header says.
-static std::string tape_texture_bytes(const std::vector<uint32_t>& words) {
-    const size_t row = size_t(glsl::kTapeTextureWidth) * 4;
-    const size_t n = std::max<size_t>(1, (words.size() + row - 1) / row) * row;
-    std::string b(n * 4, '\0');
-    for (size_t i = 0; i < words.size(); ++i)
-        for (int k = 0; k < 4; ++k) b[4 * i + size_t(k)] = char((words[i] >> (8 * k)) & 0xFFu);
-    return b;
-}
-
 int cmd_glsl(Args& a) {
     Common c = read_common(a);
     auto target = a.value("--target");
@@ -561,7 +550,7 @@ int cmd_glsl(Args& a) {
                      "%zu (error C1068: too much data in type constructor); --target html (or glsl330 with --tape-file) keeps "
                      "the tape in a texture\n",
                      g.tape_texels, kNvidiaConstArrayTexels);
-    if (tape_file) write_file(*tape_file, tape_texture_bytes(g.tape_words));  // before the shader that reads it
+    if (tape_file) write_file(*tape_file, glsl::tape_bytes(glsl::tape_texture_words(g.tape_words)));  // before the shader that reads it
     std::string text = std::move(g.text);
     if (!out) {
         write_stdout(text);

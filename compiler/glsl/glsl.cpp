@@ -330,8 +330,6 @@ std::string knob_block(const Parts& p, GlslTarget target) {
 
 namespace {
 
-size_t tape_rows(size_t words) { return std::max<size_t>(1, (words / 4 + glsl::kTapeTextureWidth - 1) / glsl::kTapeTextureWidth); }
-
 std::string target_text(const Parts& p, GlslTarget target) {
     switch (target) {
         case GlslTarget::Shadertoy: {
@@ -364,7 +362,7 @@ std::string target_text(const Parts& p, GlslTarget target) {
                     "// The scene's programs are a tape in a texture: upload the words of `sdfc glsl --tape-file`\n"
                     "// (little-endian uint32, {} texels) as an RGBA32UI texture {} texels wide and {} high\n"
                     "// (GL_RGBA_INTEGER, GL_UNSIGNED_INT, GL_NEAREST filters) and bind it to sdf_tape.\n\n",
-                    p.tape_words.size() / 4, glsl::kTapeTextureWidth, tape_rows(p.tape_words.size()));
+                    p.tape_words.size() / 4, glsl::kTapeTextureWidth, glsl::tape_texture_rows(p.tape_words.size() / 4));
             s += "uniform vec2 iResolution;\nuniform float iTime;\nuniform vec4 iMouse;\nout vec4 fragColor;\n\n";
             s += knob_block(p, target);
             s += p.code;

@@ -205,12 +205,23 @@ std::string tape_interpreter(const PackedTapes& t, TapeStorage storage) {
     return s;
 }
 
-std::string tape_base64(const std::vector<uint32_t>& words) {
-    static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+std::vector<uint32_t> tape_texture_words(const std::vector<uint32_t>& words) {
+    std::vector<uint32_t> data(tape_texture_rows(words.size() / 4) * kTapeTextureWidth * 4, 0u);
+    std::copy(words.begin(), words.end(), data.begin());
+    return data;
+}
+
+std::string tape_bytes(const std::vector<uint32_t>& words) {
     std::string bytes;
     bytes.reserve(words.size() * 4);
     for (uint32_t w : words)
         for (int i = 0; i < 4; ++i) bytes += static_cast<char>((w >> (8 * i)) & 255u);
+    return bytes;
+}
+
+std::string tape_base64(const std::vector<uint32_t>& words) {
+    static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const std::string bytes = tape_bytes(words);
     std::string out;
     out.reserve((bytes.size() + 2) / 3 * 4);
     for (size_t i = 0; i < bytes.size(); i += 3) {

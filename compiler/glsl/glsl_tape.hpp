@@ -12,6 +12,7 @@
 // Programs lie one after another; each is a segment [begin, end) of instruction indices
 // (slots in narrow, pairs of slots in wide), run by sdf_run(begin, end, p).
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -46,7 +47,16 @@ inline constexpr int kTapeTextureWidth = 1024;  // texels (uvec4) a row
 // sdf_fetch and sdf_run with a case for each opcode the tape uses.
 std::string tape_interpreter(const PackedTapes& t, TapeStorage storage);
 
-// The words as base64 (little-endian), for the html page's texture.
+// The rows of the sdf_tape texture that holds `texels` (at least one).
+inline size_t tape_texture_rows(size_t texels) {
+    return std::max<size_t>(1, (texels + kTapeTextureWidth - 1) / kTapeTextureWidth);
+}
+// The words padded with zeros to the whole texture (tape_texture_rows), as uploaded.
+std::vector<uint32_t> tape_texture_words(const std::vector<uint32_t>& words);
+
+// The words as little-endian bytes (the data of `sdfc glsl --tape-file`).
+std::string tape_bytes(const std::vector<uint32_t>& words);
+// ... as base64, for the html page's texture.
 std::string tape_base64(const std::vector<uint32_t>& words);
 
 }  // namespace sdfc::glsl

@@ -59,9 +59,8 @@ inline std::string draw_html_shader(Gles& gles, const GlslOutput& shader, int wi
         glUniform1i(u("uMaxSteps"), shader.max_steps);
         glUniform1i(u("uMaxBounces"), shader.max_bounces);
         if (!shader.tape_words.empty()) {
-            const size_t texels = shader.tape_words.size() / 4, w = glsl::kTapeTextureWidth, rows = (texels + w - 1) / w;
-            std::vector<uint32_t> data(rows * w * 4, 0u);
-            std::copy(shader.tape_words.begin(), shader.tape_words.end(), data.begin());
+            const size_t w = glsl::kTapeTextureWidth, rows = glsl::tape_texture_rows(shader.tape_words.size() / 4);
+            const std::vector<uint32_t> data = glsl::tape_texture_words(shader.tape_words);
             glGenTextures(1, &tex);
             glActiveTexture(GL_TEXTURE0);
             glBindTexture(GL_TEXTURE_2D, tex);

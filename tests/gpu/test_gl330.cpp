@@ -92,9 +92,8 @@ TEST_CASE("glsl330 with its tape in a texture draws the CPU's picture on desktop
     REQUIRE(linked);
     glUseProgram(prog);
     // The upload the shader's header asks for: whole rows of kTapeTextureWidth texels.
-    const size_t tw = glsl::kTapeTextureWidth, rows = (g.tape_texels + tw - 1) / tw;
-    std::vector<uint32_t> data(rows * tw * 4, 0u);
-    std::copy(g.tape_words.begin(), g.tape_words.end(), data.begin());
+    const size_t tw = glsl::kTapeTextureWidth, rows = glsl::tape_texture_rows(g.tape_texels);
+    const std::vector<uint32_t> data = glsl::tape_texture_words(g.tape_words);
     glGenTextures(1, &tex);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, tex);
