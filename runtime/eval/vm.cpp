@@ -1,11 +1,13 @@
 #include "runtime/eval/vm.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <iterator>
 #include <new>
+#include <utility>
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
@@ -28,6 +30,8 @@ float* alloc_regs(size_t count) {
 // runs ceil(n / kGroup) groups, the extra lanes compute on stale but harmless values.
 constexpr int kGroup = 8;
 static_assert(kBatch % kGroup == 0);
+
+using RunFn = void (*)(const Instr*, const Instr*, const Guard*, float*, const float*, const float*, const float*, int, float);
 
 }  // namespace
 
@@ -80,19 +84,15 @@ SDFC_ISA_END
 #endif
 
 namespace {
-using RunFn = void (*)(const Instr*, const Instr*, const Guard*, float*, const float*, const float*, const float*, int, int,
-                      float);
-struct Kernels {
-    RunFn full, part;
-};
-const Kernels kKernels[] = {
-    {isa_baseline::run_full, isa_baseline::run_part},
+// Each instruction set's kernels, by lane count (vm_kernel.inl).
+const RunFn* const kKernels[] = {
+    isa_baseline::runs.data(),
 #if defined(SDFC_ISA_DISPATCH)
-    {isa_avx2::run_full, isa_avx2::run_part},
-    {isa_avx512::run_full, isa_avx512::run_part},
+    isa_avx2::runs.data(),
+    isa_avx512::runs.data(),
 #endif
 };
-const Kernels& kernels() {
+const RunFn* kernels() {
     const int i = static_cast<int>(current_isa());
     return kKernels[i < int(std::size(kKernels)) ? i : 0];
 }
@@ -103,9 +103,7 @@ void BatchVM::eval(const TapeView& t, const float* x, const float* y, const floa
     if (t.num_regs > max_regs_) reserve(t.num_regs);
     const int m = (n + kGroup - 1) / kGroup * kGroup;  // lanes computed
     const Instr* end = t.code + t.len;
-    const Kernels& k = kernels();
-    if (m == kBatch) k.full(t.code, end, t.guards, regs_, x, y, z, n, m, time);
-    else k.part(t.code, end, t.guards, regs_, x, y, z, n, m, time);
+    kernels()[m / kGroup - 1](t.code, end, t.guards, regs_, x, y, z, n, time);
 }
 
 void sample_batch(const Program& p, const float* x, const float* y, const float* z, size_t n, float time, float* out) {

@@ -1,10 +1,6 @@
 // The batch VM's kernel: included by vm.cpp once per instruction set, each copy in its own
 // namespace (runtime/eval/isa.hpp); no include guard on purpose.
 
-// One pass over the program with the lane count M known at compile time when FULL (the
-// loops unroll completely) or given at run time (m, a multiple of kGroup) otherwise.
-// Dispatch is a computed goto with one indirect jump per handler (GCC/clang), which the
-// branch predictor learns per opcode, or a switch elsewhere.
 // Whether every one of the n points is far enough outside guard g's box to skip its region
 // (program.hpp Guard): farther than the threshold `thr` by a margin that covers the region's
 // rounding errors (its distance is never below the box's in exact arithmetic), so that
@@ -33,10 +29,23 @@ inline bool guard_skips_all(const Guard& g, const float* base, const float* thr,
     return fail == 0;
 }
 
-template <bool FULL>
-inline void run(const Instr* code, const Instr* end, const Guard* guards, float* base, const float* x, const float* y,
-                       const float* z, int n, int m_rt, float time) {
-    const int m = FULL ? kBatch : m_rt;
+// One pass over the program for M lanes (a multiple of kGroup, at most kBatch), a count
+// known at compile time: each op is a fixed run of vector instructions without a loop's
+// set-up, which dominated the small batches of a window's lanes split by tape-tree leaf (the
+// 10,000-sphere grid: 10.7 points a batch; with a kernel per count, 0.87x its time).
+// Dispatch is a computed goto with one indirect jump per handler (GCC/clang), which the
+// branch predictor learns per opcode, or a switch elsewhere.
+#if defined(__GNUC__) && !defined(__clang__)
+// (else GCC unrolls a loop of a few fixed lanes into scalar code, which is slower; a full
+// batch's loop unrolls into vector code and is faster so)
+#define SDFC_NO_UNROLL _Pragma("GCC unroll 1")
+#else
+#define SDFC_NO_UNROLL
+#endif
+template <int M>
+void run(const Instr* code, const Instr* end, const Guard* guards, float* base, const float* x, const float* y,
+         const float* z, int n, float time) {
+    constexpr int m = M;
     auto load = [&](float* R, const float* src) {
         std::memcpy(R, src, sizeof(float) * static_cast<size_t>(n));
         for (int i = n; i < m; ++i) R[i] = src[n - 1];  // keep padding lanes finite
@@ -82,12 +91,23 @@ inline void run(const Instr* code, const Instr* end, const Guard* guards, float*
         } else if constexpr (vmath::kVector<Op::name>) {                           \
             vmath::apply<Op::name>(R, A, B, k, m);                                 \
         } else {                                                                   \
-            SDFC_IVDEP                                                             \
-            for (int i = 0; i < m; ++i) {                                          \
-                [[maybe_unused]] const float a = A[i];                             \
-                [[maybe_unused]] const float b = B[i];                             \
-                [[maybe_unused]] const float c = C[i];                             \
-                R[i] = (sem);                                                      \
+            if constexpr (M < kBatch) {                                            \
+                SDFC_IVDEP                                                         \
+                SDFC_NO_UNROLL                                                     \
+                for (int i = 0; i < M; ++i) {                                      \
+                    [[maybe_unused]] const float a = A[i];                         \
+                    [[maybe_unused]] const float b = B[i];                         \
+                    [[maybe_unused]] const float c = C[i];                         \
+                    R[i] = (sem);                                                  \
+                }                                                                  \
+            } else {                                                               \
+                SDFC_IVDEP                                                         \
+                for (int i = 0; i < m; ++i) {                                      \
+                    [[maybe_unused]] const float a = A[i];                         \
+                    [[maybe_unused]] const float b = B[i];                         \
+                    [[maybe_unused]] const float c = C[i];                         \
+                    R[i] = (sem);                                                  \
+                }                                                                  \
             }                                                                      \
         }                                                                          \
     }                                                                              \
@@ -101,11 +121,10 @@ inline void run(const Instr* code, const Instr* end, const Guard* guards, float*
 #undef SDFC_CASE
 }
 
-void run_full(const Instr* code, const Instr* end, const Guard* guards, float* base, const float* x, const float* y,
-              const float* z, int n, int m, float time) {
-    run<true>(code, end, guards, base, x, y, z, n, m, time);
+// The kernels by lane count: runs[m / kGroup - 1] runs m lanes.
+template <int... G>
+constexpr std::array<RunFn, sizeof...(G)> make_runs(std::integer_sequence<int, G...>) {
+    return {&run<(G + 1) * kGroup>...};
 }
-void run_part(const Instr* code, const Instr* end, const Guard* guards, float* base, const float* x, const float* y,
-              const float* z, int n, int m, float time) {
-    run<false>(code, end, guards, base, x, y, z, n, m, time);
-}
+constexpr auto runs = make_runs(std::make_integer_sequence<int, kBatch / kGroup>());
+#undef SDFC_NO_UNROLL
