@@ -15,6 +15,7 @@
 #include "runtime/cpu/frame.hpp"
 #include "runtime/cpu/tape_tree.hpp"
 #include "runtime/cpu/tracer.hpp"
+#include "runtime/eval/interval.hpp"
 #include "support.hpp"
 
 using namespace sdfc;
@@ -202,6 +203,42 @@ TEST_CASE("accel: a thin layer of shapes lies above the tree root's midplane, no
     REQUIRE(cpu::tree_root(g, thick->cs, ro, lo, hi, &layer));
     CHECK_FALSE(layer);
     CHECK(0.5f * (lo.y + hi.y) == Approx(0.5f * (g.lo.y + g.hi.y)).margin(1e-4));
+}
+
+TEST_CASE("accel: under a thin layer the tree splits no cell proven empty", "[accel]") {
+    // 3,600 floating spheres (tests above): the air just over the layer keeps nearly every
+    // sphere within reach in its tapes, so under a thin layer the node budget goes to the
+    // cells that may hold surface (tape_tree.cpp kTreeThinNear). Elsewhere empty cells near
+    // the surface are split too (kTreeNear), as the same tree built without the layer shows.
+    auto c = test::compile_text(grid_scene(60, 160, 90, false));
+    RenderOptions ro;
+    const cpu::Frame f = cpu::make_frame(c->cs, ro);
+    glm::vec3 lo, hi;
+    bool layer = false;
+    REQUIRE(cpu::tree_root(f, c->cs, ro, lo, hi, &layer));
+    REQUIRE(layer);
+    const Tape full = Tape::from(c->cs.distance, 0);
+    IntervalEvaluator iv(full.num_regs, full.choices);
+    // The split nodes whose box the whole program's interval proves empty (a tape simplified
+    // for a box around it is never less sure).
+    auto empty_splits = [&](const cpu::TapeTree& T) {
+        int n = 0;
+        for (size_t i = 1; i < T.nodes.size(); ++i) {
+            if (T.nodes[i].child & cpu::TapeTree::kLeafBit) continue;
+            const auto& B = T.boxes_[i];
+            iv.eval(full, &B.lo[0], &B.hi[0], &B.lo[1], &B.hi[1], &B.lo[2], &B.hi[2], 1);
+            n += iv.result(0).lo > 0.0f;
+        }
+        return n;
+    };
+    cpu::TapeTree thin, plain;
+    cpu::build_tree(thin, c->cs.distance, lo, hi, 0.0f, true, 160 * 90, true);
+    cpu::build_tree(plain, c->cs.distance, lo, hi, 0.0f, true, 160 * 90, false);
+    REQUIRE(thin.active);
+    REQUIRE(plain.active);
+    INFO("nodes " << thin.nodes.size() << " / " << plain.nodes.size());
+    CHECK(empty_splits(thin) == 0);
+    CHECK(empty_splits(plain) > 0);
 }
 
 TEST_CASE("accel: a raw field's tree splits cells however short their tapes, and its rays jump more", "[accel]") {
