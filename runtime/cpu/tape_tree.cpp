@@ -58,7 +58,7 @@ constexpr float kTreeNear = 0.25f;        // empty cells are split when the surf
 // ... but not under a thin layer: there the settled cells near the surface are the air just
 // above (or the ground just below) the layer, whose tapes keep nearly every object within
 // reach, so their splits spend the node budget for little (the 10,000-sphere grid at
-// 640 x 360, 2 threads: 0.90x the time, 1,024 spheres 0.94x; not for the examples, which
+// 640 x 360, 2 threads: 0.93x the time, 1,024 spheres 0.95x; not for the examples, which
 // have no thin layer: showcase.sdf takes 1.17x without them, vases.sdf 1.04x).
 constexpr float kTreeThinNear = 0.0f;
 constexpr size_t kTreeRound = 64;         // cells split in parallel per round

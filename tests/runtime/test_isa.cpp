@@ -165,8 +165,9 @@ TEST_CASE("isa: the transcendental ops give the scalar semantics' bits with ever
                 std::string first;
                 for (size_t i0 = 0; i0 < xs.size(); i0 += kBatch) {
                     // Partial batches too: 64, 55, ... 1 points run every kernel (one per lane
-                    // count: 8, 16, ... 64).
-                    for (int n = kBatch - 5 * int(i0 == 0); n > 0; n -= 9) {
+                    // count: 8, 16, ... 64), within the values left.
+                    const int full = static_cast<int>(std::min<size_t>(kBatch, xs.size() - i0));
+                    for (int n = full - 5 * int(i0 == 0); n > 0; n -= 9) {
                         vm.eval(p.view(), xs.data() + i0, ys.data() + i0, zs, n, 0.0f);
                         for (int i = 0; i < n; ++i) {
                             const float want = eval_op(op, xs[i0 + i], ys[i0 + i], 0.0f, k), got = vm.output(p.view())[i];
