@@ -111,6 +111,10 @@ struct Ctx {
     float time;
     Pool* pool;
     std::vector<float> xc, yc;  // coord_x / coord_y of every column / row
+    // The x and y inputs of every full 8 x 8 leaf batch, by column block and row block
+    // (block_inputs): a leaf hands the VM these rows instead of writing its own just before,
+    // whose narrower stores the VM's wide loads then waited for (store forwarding fails).
+    std::vector<float> xb, yb;
     std::vector<int> sizes;  // tile size per depth: sizes[0] the root, the last the leaves
     int threads = 1;
     std::atomic<uint64_t> points{0};  // the scratch objects' counts, as they go back to the pool
@@ -136,22 +140,21 @@ void leaf(Ctx& c, Scratch& s, const TapeView& tape, int x0, int y0, int size) {
             const int x1 = std::min(bx + 8, c.w), y1 = std::min(by + 8, c.h);
             const int cols = x1 - bx, rows = y1 - by, n = cols * rows;
             alignas(64) float xs[kBatch], ys[kBatch], in[kBatch];  // lanes >= n are never read
-            const float* xc = c.xc.data() + bx;
-            const float* yc = c.yc.data() + by;
-            if (cols == 8 && rows == 8) {  // the common case, in fixed-size loops
-                for (int r = 0; r < 8; ++r)
-                    for (int q = 0; q < 8; ++q) {
-                        xs[r * 8 + q] = xc[q];
-                        ys[r * 8 + q] = yc[r];
-                    }
+            const float* px = xs;
+            const float* py = ys;
+            if (cols == 8 && rows == 8) {  // the common case
+                px = c.xb.data() + size_t(bx) * 8;
+                py = c.yb.data() + size_t(by) * 8;
             } else {
+                const float* xc = c.xc.data() + bx;
+                const float* yc = c.yc.data() + by;
                 for (int r = 0; r < rows; ++r)
                     for (int q = 0; q < cols; ++q) {
                         xs[r * cols + q] = xc[q];
                         ys[r * cols + q] = yc[r];
                     }
             }
-            s.ev.eval(tape, xs, ys, zs, n, c.time);
+            s.ev.eval(tape, px, py, zs, n, c.time);
             const float* d = s.ev.output(tape);
             // Into a local row first: the compiler cannot tell the picture from the VM's
             // registers, and would write pixel by pixel.
@@ -301,6 +304,19 @@ void pixel_grid(int w, int h, std::vector<float>& xc, std::vector<float>& yc) {
     for (int j = 0; j < h; ++j) yc[size_t(j)] = coord_y(j, h);
 }
 
+// Ctx::xb / yb: for each full block of 8 columns (rows), the 64 lanes' x (y) in leaf order
+// (lane r * 8 + q is pixel (bx + q, by + r)).
+void block_inputs(Ctx& c) {
+    c.xb.assign(size_t(c.w / kLeaf) * kBatch, 0.0f);
+    c.yb.assign(size_t(c.h / kLeaf) * kBatch, 0.0f);
+    for (int b = 0; b < c.w / kLeaf; ++b)
+        for (int r = 0; r < kLeaf; ++r)
+            for (int q = 0; q < kLeaf; ++q) c.xb[size_t(b) * kBatch + size_t(r * kLeaf + q)] = c.xc[size_t(b * kLeaf + q)];
+    for (int b = 0; b < c.h / kLeaf; ++b)
+        for (int r = 0; r < kLeaf; ++r)
+            for (int q = 0; q < kLeaf; ++q) c.yb[size_t(b) * kBatch + size_t(r * kLeaf + q)] = c.yc[size_t(b * kLeaf + r)];
+}
+
 // At most `threads` worker threads while it lives (0: all).
 std::unique_ptr<tbb::global_control> thread_limit(int threads) {
     if (threads <= 0) return nullptr;
@@ -359,6 +375,7 @@ Image Raster2d::render(int w, int h, int threads, RenderStats* stats) const {
     Ctx c{w, h, nullptr, p_->scene.time, &pool};
     c.threads = threads > 0 ? threads : tbb::this_task_arena::max_concurrency();
     pixel_grid(w, h, c.xc, c.yc);
+    block_inputs(c);
 
     int size = kLeaf;
     while (size < w || size < h) size *= 2;
