@@ -139,8 +139,7 @@ struct Buckets {
     uint32_t cur = 0;
     uint32_t key_of[kWindow];
     int count[kWindow + 1], start[kWindow + 1], nb = 0;
-    // (order: 7 more entries, copies of the last lane, for BatchVM::eval_gather's padding)
-    uint16_t bucket[kWindow], order[kWindow + 8];
+    uint16_t bucket[kWindow], order[kWindow];
     void build(const uint32_t* leaf, int n) {
         if (++cur == 0) std::fill_n(gen, kSlots, 0u), cur = 1;
         nb = 0;
@@ -161,7 +160,6 @@ struct Buckets {
         start[nb] = acc;
         for (int b = 0; b < nb; ++b) count[b] = start[b];
         for (int i = 0; i < n; ++i) order[count[bucket[i]]++] = static_cast<uint16_t>(i);
-        for (int i = n; i < n + 7; ++i) order[i] = order[n - 1];
     }
 };
 

@@ -53,6 +53,7 @@ private:
     std::vector<float> lw_, lnx_, lny_, lnz_, ao_, lrad_;
     uint32_t pleaf_[kWindow], merged_[kWindow];
     int kind_ = RenderStats::kRays;  // what the distance evaluations are for (stats)
+    alignas(64) float gx_[kBatch], gy_[kBatch], gz_[kBatch];
 
     std::unique_ptr<Lanes> lanes_;
     std::unique_ptr<Buckets> buckets_;
@@ -92,7 +93,8 @@ private:
             for (int j0 = B.start[b]; j0 < B.start[b + 1]; j0 += kBatch) {
                 const int m = std::min(kBatch, B.start[b + 1] - j0);
                 const uint16_t* ord = B.order + j0;
-                dist_.eval_gather(tape, x, y, z, ord, m, f_.time);
+                for (int j = 0; j < m; ++j) gx_[j] = x[ord[j]], gy_[j] = y[ord[j]], gz_[j] = z[ord[j]];
+                dist_.eval(tape, gx_, gy_, gz_, m, f_.time);
                 const float* d = dist_.output(tape);
                 for (int j = 0; j < m; ++j) out[ord[j]] = d[j];
             }

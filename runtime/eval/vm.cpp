@@ -31,8 +31,7 @@ float* alloc_regs(size_t count) {
 constexpr int kGroup = 8;
 static_assert(kBatch % kGroup == 0);
 
-using RunFn = void (*)(const Instr*, const Instr*, const Guard*, float*, const float*, const float*, const float*,
-                      const uint16_t*, int, float);
+using RunFn = void (*)(const Instr*, const Instr*, const Guard*, float*, const float*, const float*, const float*, int, float);
 
 }  // namespace
 
@@ -104,15 +103,7 @@ void BatchVM::eval(const TapeView& t, const float* x, const float* y, const floa
     if (t.num_regs > max_regs_) reserve(t.num_regs);
     const int m = (n + kGroup - 1) / kGroup * kGroup;  // lanes computed
     const Instr* end = t.code + t.len;
-    kernels()[m / kGroup - 1](t.code, end, t.guards, regs_, x, y, z, nullptr, n, time);
-}
-
-void BatchVM::eval_gather(const TapeView& t, const float* x, const float* y, const float* z, const uint16_t* idx, int n,
-                          float time) {
-    if (n <= 0) return;
-    if (t.num_regs > max_regs_) reserve(t.num_regs);
-    const int m = (n + kGroup - 1) / kGroup * kGroup;
-    kernels()[m / kGroup - 1](t.code, t.code + t.len, t.guards, regs_, x, y, z, idx, n, time);
+    kernels()[m / kGroup - 1](t.code, end, t.guards, regs_, x, y, z, n, time);
 }
 
 void sample_batch(const Program& p, const float* x, const float* y, const float* z, size_t n, float time, float* out) {

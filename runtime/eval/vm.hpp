@@ -23,12 +23,6 @@ public:
     // the next call. A tape needing more than max_regs() registers grows the register file
     // (the only allocation after construction); one with num_regs 0 must fit.
     void eval(const TapeView& t, const float* x, const float* y, const float* z, int n, float time = 0.0f);
-    // The same at the points idx[0, n) of x, y, z (lane i gets point idx[i]), gathered by
-    // the kernel itself: lanes grouped from a wider set need no copy of their own, whose
-    // scalar stores the kernel's vector loads would wait for. idx must hold n rounded up to
-    // a multiple of 8 entries, each a readable point (the extra lanes compute unused values).
-    void eval_gather(const TapeView& t, const float* x, const float* y, const float* z, const uint16_t* idx, int n,
-                     float time = 0.0f);
     const float* output(const TapeView& t, uint32_t i = 0) const { return reg(t.output(i)); }
     const float* reg_data(uint32_t r) const { return reg(r); }
     uint32_t max_regs() const { return max_regs_; }

@@ -42,37 +42,11 @@ inline bool guard_skips_all(const Guard& g, const float* base, const float* thr,
 #else
 #define SDFC_NO_UNROLL
 #endif
-// R[i] = src[idx[i]] for M lanes, written by full vector stores (GCC does not vectorise this
-// loop by itself).
-template <int M>
-SDFC_IV_INLINE void gather(float* R, const float* src, const uint16_t* idx) {
-#if SDFC_VMATH_LANES >= 8 && defined(__GNUC__) && defined(__x86_64__)
-    int i = 0;
-#if SDFC_VMATH_LANES >= 16
-    for (; i + 16 <= M; i += 16) {
-        const __m512i v = _mm512_maskz_cvtepu16_epi32(__mmask16(0xFFFF), _mm256_loadu_si256(reinterpret_cast<const __m256i*>(idx + i)));
-        _mm512_storeu_ps(R + i, _mm512_mask_i32gather_ps(_mm512_setzero_ps(), __mmask16(0xFFFF), v, src, 4));
-    }
-#endif
-    for (; i < M; i += 8) {
-        const __m256i v = _mm256_cvtepu16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(idx + i)));
-        const __m256 all = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
-        _mm256_storeu_ps(R + i, _mm256_mask_i32gather_ps(_mm256_setzero_ps(), src, v, all, 4));
-    }
-#else
-    for (int i = 0; i < M; ++i) R[i] = src[idx[i]];
-#endif
-}
-
 template <int M>
 void run(const Instr* code, const Instr* end, const Guard* guards, float* base, const float* x, const float* y,
-         const float* z, const uint16_t* idx, int n, float time) {
+         const float* z, int n, float time) {
     constexpr int m = M;
     auto load = [&](float* R, const float* src) {
-        if (idx) {  // BatchVM::eval_gather (all M entries readable): vector gathers where there are
-            gather<M>(R, src, idx);
-            return;
-        }
         std::memcpy(R, src, sizeof(float) * static_cast<size_t>(n));
         for (int i = n; i < m; ++i) R[i] = src[n - 1];  // keep padding lanes finite
     };
