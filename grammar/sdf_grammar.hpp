@@ -288,11 +288,13 @@ struct field_expr : seq<kw<kw_field>, opt<not_at<field_param_ahead>, field_args>
 struct brace_primary : sor<block, field_expr, if_expr, for_expr> {};
 
 // Modifier application, OpenSCAD style: a call or name directly followed by a target
-// (a shape expression, a block, a for or an if) applies to it; nests to the right.
+// (a shape expression, a block, a for or an if) applies to it; nests to the right. A target
+// that begins with a name is a whole expression, so `translate(v) k > 1 ? a : b` moves the
+// conditional's shape, not k.
 // (The guard comes after the nesting check: the depth limit applies to every attempt.)
 struct ident_postfix;
-struct target_start : sor<one<'{'>, identifier_first> {};
-struct apply_target : seq<at<target_start>, sor<block, for_expr, if_expr, field_expr, ident_postfix>>, nesting {};
+struct target_start : sor<one<'{'>, identifier_first, digit> {};
+struct apply_target : seq<at<target_start>, sor<block, for_expr, if_expr, field_expr, ternary>>, nesting {};
 struct ident_postfix : seq<at<identifier_first>, ident_expr, postfix_ops, opt<apply_target>> {};
 struct other_postfix : seq<simple_primary, postfix_ops> {};
 struct postfix_expr : sor<ident_postfix, other_postfix, brace_primary> {};

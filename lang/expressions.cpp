@@ -287,6 +287,12 @@ Value Interp::call_value(const Value& callee, const std::vector<ast::Arg>& args,
         NodeId d = lower_distance(*g, *callee.shape, pv);
         return Value::number(d);
     }
+    if (callee.t == VT::Modifier && args.size() == 1 && args[0].name.empty()) {
+        // `translate(v) (k > 1 ? a : b)`: the parenthesised target reads as a call.
+        Value t = eval(*args[0].value, env);
+        ShapePtr target = to_shape(t, args[0].loc, fmt::format("the target of {}", callee.mod->name).c_str());
+        return Value::of_shape(apply_modifier(*callee.mod, target, loc));
+    }
     fail(loc, fmt::format("{} cannot be called", describe(callee)));
 }
 

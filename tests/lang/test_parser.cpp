@@ -209,7 +209,12 @@ TEST_CASE("operator precedence and associativity", "[parser]") {
     CHECK(ex("a-1") == "(- a 1)");
     CHECK(ex("a*-1") == "(* a (neg 1))");
     CHECK(ex("k > 0 ? sphere(1) : { box(1); }") == "(? (> k 0) (call sphere 1) {(call box 1); })");
-    CHECK(ex("translate(v) box(1) + 1") == "(+ (apply (call translate v) (call box 1)) 1)");
+    // A modifier's target that begins with a name or a number is a whole expression.
+    CHECK(ex("translate(v) box(1) + 1") == "(apply (call translate v) (+ (call box 1) 1))");
+    CHECK(ex("translate(v) k > 1 ? sphere(1) : box(1)") == "(apply (call translate v) (? (> k 1) (call sphere 1) (call box 1)))");
+    CHECK(ex("translate(v) 1 > 0 ? a : b") == "(apply (call translate v) (? (> 1 0) a b))");
+    CHECK(ex("c ? translate(v) a : b") == "(? c (apply (call translate v) a) b)");
+    CHECK(ex("f(translate(v) a, b)") == "(call f (apply (call translate v) a) b)");
 }
 
 TEST_CASE("postfix: calls, indexing, swizzles", "[parser]") {

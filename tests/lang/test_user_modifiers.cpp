@@ -23,6 +23,19 @@ TEST_CASE("a def written before a shape or a block takes it as its last argument
     CHECK(dist_of(defs + "at(1, 0, sphere(1));", 3, 0, 0) == Approx(-1.0f));
 }
 
+TEST_CASE("a modifier takes a conditional shape, bare or in parentheses", "[lang]") {
+    // The contract's `k > 0 ? sphere(1) : { ... }` is a shape statement, so a modifier applies
+    // to all of it (not to k); in parentheses it reads as a call of the operation.
+    CHECK(dist_of("let k = 2;\ntranslate([4, 0, 0]) k > 1 ? sphere(0.3) : box(0.5);", 4, 0, 0) == Approx(-0.3f));
+    CHECK(dist_of("let k = 0;\ntranslate([4, 0, 0]) k > 1 ? sphere(0.3) : box(0.5);", 4, 0, 0) == Approx(-0.25f));
+    CHECK(dist_of("let k = 2;\ntranslate([4, 0, 0]) (k > 1 ? sphere(0.3) : box(0.5));", 4, 0, 0) == Approx(-0.3f));
+    CHECK(dist_of("rotate(y = 90) translate([0, 2, 0]) 1 > 0 ? sphere(0.5) : box(1);", 0, 2, 0) == Approx(-0.5f));
+    CHECK(dist_of("def at(v, s) = translate(v) s;\nlet k = 2;\nat([0, 0, 3]) k > 1 ? sphere(1) : box(1);", 0, 0, 3) ==
+          Approx(-1.0f));
+    CHECK(first_error_line("translate([1, 0, 0]) (1 + 2);") ==
+          "test.sdf:1:23: error: the target of translate must be a shape, not a number");
+}
+
 TEST_CASE("a user modifier's errors name it", "[lang]") {
     CHECK(first_error_line("def f(x) = x * 2;\nf(1) sphere(1);") ==
           "test.sdf:2:1: error: a number is written before a shape but is not an operation");
