@@ -427,18 +427,28 @@ int cmd_eval(Args& a) {
         xs.push_back(f[0]); ys.push_back(f[1]); zs.push_back(f[2]);
     }
     if (points) {
-        std::istringstream in(read_bounded(*points, c.interp.limits.max_file_bytes));
-        std::string line;
-        int ln = 0;
-        while (std::getline(in, line)) {
-            ++ln;
-            std::istringstream ss(line);
-            float x, y, z;
-            std::string rest;
-            if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-            if (!(ss >> x >> y >> z) || (ss >> rest))
-                throw UsageError(fmt::format("{}:{}: expected three numbers \"x y z\"", *points, ln));
-            xs.push_back(x); ys.push_back(y); zs.push_back(z);
+        // A bad line is an error in an input file: path:line:col, the line and a caret, exit 1.
+        const SourceFile file(*points, read_bounded(*points, c.interp.limits.max_file_bytes));
+        for (uint32_t ln = 1; ln <= file.line_starts.size(); ++ln) {
+            const std::string_view line = file.line(ln);
+            float v[3];
+            size_t pos = 0;
+            int k = 0;
+            for (;; ++k) {
+                pos = line.find_first_not_of(" \t\r", pos);
+                if (pos == std::string_view::npos) break;
+                const size_t end = std::min(line.find_first_of(" \t\r", pos), line.size());
+                std::istringstream ts{std::string(line.substr(pos, end - pos))};
+                float f = 0.0f;
+                if (k == 3 || !(ts >> f) || ts.peek() != std::char_traits<char>::eof())
+                    throw CompileError(Loc{&file, ln, uint32_t(pos + 1)}, k == 3 ? "expected three numbers \"x y z\", not more"
+                                                                                 : "expected three numbers \"x y z\"");
+                v[k] = f;
+                pos = end;
+            }
+            if (k == 0) continue;  // a blank line
+            if (k < 3) throw CompileError(Loc{&file, ln, uint32_t(line.size() + 1)}, "expected three numbers \"x y z\"");
+            xs.push_back(v[0]); ys.push_back(v[1]); zs.push_back(v[2]);
         }
     }
     SourceManager sm;

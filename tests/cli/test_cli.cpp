@@ -67,6 +67,17 @@ TEST_CASE("eval prints one distance per line") {
     auto bad = run_sdfc("eval '" + s + "' --at 1,2");
     CHECK(bad.status == 2);
     CHECK(bad.err == "sdfc: error: --at takes 3 comma-separated numbers, not '1,2'\n");
+    // A bad line of a points file is an input file's error: its place, the line, a caret.
+    std::string few = test::write_temp("pts_few.txt", "1 2 3\n4 5\n");
+    auto r3 = run_sdfc("eval '" + s + "' --points '" + few + "'");
+    CHECK(r3.status == 1);
+    CHECK(r3.err == few + ":2:4: error: expected three numbers \"x y z\"\n4 5\n   ^\n");
+    std::string word = test::write_temp("pts_word.txt", "1 2 3\r\n 4 x 5\r\n");
+    auto r4 = run_sdfc("eval '" + s + "' --points '" + word + "'");
+    CHECK(r4.status == 1);
+    CHECK(r4.err.rfind(word + ":2:4: error: expected three numbers \"x y z\"\n", 0) == 0);
+    std::string many = test::write_temp("pts_many.txt", "1 2 3 4\n");
+    CHECK(run_sdfc("eval '" + s + "' --points '" + many + "'").err.rfind(many + ":1:7: error: expected three numbers \"x y z\", not more\n", 0) == 0);
 }
 
 TEST_CASE("check reports script errors with a caret and exit 1") {
