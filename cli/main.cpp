@@ -560,8 +560,12 @@ int cmd_glsl(Args& a) {
                      "%zu (error C1068: too much data in type constructor); --target html (or glsl330 with --tape-file) keeps "
                      "the tape in a texture\n",
                      g.tape_texels, kNvidiaConstArrayTexels);
-    if (tape_file) write_file(*tape_file, glsl::tape_bytes(glsl::tape_texture_words(g.tape_words)));  // before the shader that reads it
     std::string text = std::move(g.text);
+    if (tape_file) {  // both or neither; the tape first, before the shader that reads it
+        const std::string tape = glsl::tape_bytes(glsl::tape_texture_words(g.tape_words));
+        write_files(*tape_file, tape, out ? *out : "-", text);
+        return 0;
+    }
     if (!out) {
         write_stdout(text);
         return 0;

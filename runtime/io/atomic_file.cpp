@@ -169,38 +169,38 @@ OutputTarget resolve_output(const std::string& path) {
     return t;
 }
 
-void write_file(const std::string& path, std::string_view bytes) {
+namespace {
+void write_stdout_bytes(std::string_view bytes) {
+    // After what the program printed there itself.
+    std::fflush(stdout);
+    try {
+        write_all(STDOUT_FILENO, bytes.data(), bytes.size(), "-");
+    } catch (const std::runtime_error& e) {
+        const std::string what = e.what(), prefix = "cannot write '-': ";
+        throw std::runtime_error("cannot write to standard output: " + (what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what));
+    }
+}
+}  // namespace
+
+StagedFile::StagedFile(const std::string& path, std::string_view bytes) : path_(path) {
     if (path == "-") {
-        // After what the program printed there itself.
-        std::fflush(stdout);
-        try {
-            write_all(STDOUT_FILENO, bytes.data(), bytes.size(), path);
-        } catch (const std::runtime_error& e) {
-            const std::string what = e.what(), prefix = "cannot write '-': ";
-            throw std::runtime_error("cannot write to standard output: " + (what.rfind(prefix, 0) == 0 ? what.substr(prefix.size()) : what));
-        }
+        through_ = true;
+        bytes_ = bytes;
         return;
     }
-    const OutputTarget t = resolve_output(path);
-    if (t.write_through) {
-        int fd = ::open(t.file.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
-        if (fd < 0) fail(path, os_reason(errno));
-        try {
-            write_all(fd, bytes.data(), bytes.size(), path);
-        } catch (...) {
-            ::close(fd);
-            throw;
-        }
-        if (::close(fd) != 0 && errno != EINTR) fail(path, os_reason(errno));
+    target_ = resolve_output(path);
+    if (target_.write_through) {
+        through_ = true;
+        bytes_ = bytes;
         return;
     }
-    TempFile tmp(temp_path_for(t.file));
-    int fd = ::open(tmp.path().c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    tmp_ = std::make_unique<TempFile>(temp_path_for(target_.file));
+    int fd = ::open(tmp_->path().c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd < 0) fail(path, os_reason(errno));
     try {
         test_delay();
         write_all(fd, bytes.data(), bytes.size(), path);
-        if (t.exists) (void)::fchmod(fd, t.mode);  // a replaced file keeps its permissions
+        if (target_.exists) (void)::fchmod(fd, target_.mode);  // a replaced file keeps its permissions
         // The data must be on the disk before the rename makes it the output (some file
         // systems report a full disk only here).
         if (::fsync(fd) != 0 && errno != EINVAL) fail(path, os_reason(errno));
@@ -209,14 +209,47 @@ void write_file(const std::string& path, std::string_view bytes) {
         throw;
     }
     if (::close(fd) != 0 && errno != EINTR) fail(path, os_reason(errno));
-    if (::rename(tmp.path().c_str(), t.file.c_str()) != 0) fail(path, os_reason(errno));
-    tmp.keep();
+}
+
+StagedFile::~StagedFile() = default;
+
+void StagedFile::commit() {
+    if (path_ == "-") return write_stdout_bytes(bytes_);
+    if (through_) {
+        int fd = ::open(target_.file.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+        if (fd < 0) fail(path_, os_reason(errno));
+        try {
+            write_all(fd, bytes_.data(), bytes_.size(), path_);
+        } catch (...) {
+            ::close(fd);
+            throw;
+        }
+        if (::close(fd) != 0 && errno != EINTR) fail(path_, os_reason(errno));
+        return;
+    }
+    if (::rename(tmp_->path().c_str(), target_.file.c_str()) != 0) fail(path_, os_reason(errno));
+    tmp_->keep();
     // The rename itself to the disk; a folder that cannot be synced is no error.
-    fs::path dir = fs::path(t.file).parent_path();
+    fs::path dir = fs::path(target_.file).parent_path();
     int dfd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (dfd >= 0) {
         (void)::fsync(dfd);
         ::close(dfd);
+    }
+}
+
+void write_file(const std::string& path, std::string_view bytes) { StagedFile(path, bytes).commit(); }
+
+void write_files(const std::string& first, std::string_view first_bytes, const std::string& second, std::string_view second_bytes) {
+    StagedFile a(first, first_bytes), b(second, second_bytes);
+    // A node written through can still fail after a rename could no longer be taken back:
+    // it goes first, then the renames, which fail only if the folder changed meanwhile.
+    if (b.written_through() && !a.written_through()) {
+        b.commit();
+        a.commit();
+    } else {
+        a.commit();
+        b.commit();
     }
 }
 

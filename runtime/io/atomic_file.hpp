@@ -6,6 +6,7 @@
 // is not a regular file (a directory, a socket) is refused. Every error names the user's
 // path and the OS reason: "cannot write 'PATH': REASON". The path "-" is standard output.
 #pragma once
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -30,6 +31,11 @@ std::string temp_path_for(const std::string& target);
 
 // Writes `bytes` to `path` as described at the top. Throws std::runtime_error.
 void write_file(const std::string& path, std::string_view bytes);
+// Two files that go together (a shader and the tape it loads): both are written to their
+// temporary files before either appears, so a failure leaves neither. `first` appears
+// first, unless only `second` is written through (a device, a FIFO, standard output),
+// which can fail late: then it goes first.
+void write_files(const std::string& first, std::string_view first_bytes, const std::string& second, std::string_view second_bytes);
 // Text (GLSL, HTML): write_file under another name.
 void write_text_file(const std::string& path, const std::string& text);
 
@@ -51,6 +57,27 @@ private:
     std::string path_;
     int slot_ = -1;
     bool keep_ = false;
+};
+
+// write_file in two steps: the constructor writes the bytes to a temporary file beside the
+// target (or, for a node written through and standard output, only checks the path and
+// keeps the bytes); commit() renames it over the target (or writes them through). A staged
+// file never committed leaves nothing. Both throw std::runtime_error.
+class StagedFile {
+public:
+    StagedFile(const std::string& path, std::string_view bytes);
+    ~StagedFile();
+    StagedFile(const StagedFile&) = delete;
+    StagedFile& operator=(const StagedFile&) = delete;
+    void commit();
+    bool written_through() const { return through_; }
+
+private:
+    std::string path_;
+    OutputTarget target_;
+    bool through_ = false;
+    std::string_view bytes_;  // (written through: the caller's, alive until commit)
+    std::unique_ptr<TempFile> tmp_;
 };
 
 // Installs the signal handlers that remove live temporary files before the process dies of

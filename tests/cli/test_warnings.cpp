@@ -88,4 +88,17 @@ TEST_CASE("glsl330 --tape-file writes the tape for a texture, and refuses what c
     CHECK(bad.err == "sdfc: error: --tape-file and the shader would both go to '-'\n");
     bad = run_sdfc("glsl " + q(s) + " --target glsl330 --tape-file " + q(test::temp_dir() + "/no/such/dir/t.tape") + " -o " + q(out));
     CHECK(bad.status != 0);
+    // The shader and its tape come together or not at all: a shader that cannot be written
+    // leaves no tape (nor its temporary file).
+    const std::string tape2 = test::temp_dir() + "/many_tex2.tape";
+    std::remove(tape2.c_str());
+    bad = run_sdfc("glsl " + q(s) + " --target glsl330 --tape-file " + q(tape2) + " -o /dev/full");
+    CHECK(bad.status == 1);
+    CHECK(bad.err == "sdfc: error: cannot write '/dev/full': No space left on device\n");
+    CHECK(!std::ifstream(tape2).good());
+    bad = run_sdfc("glsl " + q(s) + " --target glsl330 --tape-file " + q(tape2) + " -o " + q(test::temp_dir() + "/no/such/dir/s.glsl"));
+    CHECK(bad.status != 0);
+    CHECK(!std::ifstream(tape2).good());
+    for (const auto& e : std::filesystem::directory_iterator(test::temp_dir()))
+        CHECK(e.path().filename().string().rfind(".many_tex2", 0) == std::string::npos);
 }
