@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <new>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -647,6 +648,10 @@ int run_command(const std::vector<std::string>& all) {
     } catch (const sdfc::DefineError& e) {  // a -D the script cannot take: the command line too
         std::fprintf(stderr, "sdfc: error: %s\n", e.what());
         return 2;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "sdfc: error: out of memory: the work is too big for this machine (a smaller picture, fewer samples, "
+                             "or lower --max-* limits)\n");
+        return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "sdfc: error: %s\n", e.what());
         return 1;

@@ -191,3 +191,19 @@ TEST_CASE("flag --max-pixels (width x height x samples) and --max-frames, no out
     CHECK(r.status == 0);
     CHECK(fs::exists(test::temp_dir() + "/lim_frame_0001.png"));
 }
+
+// Memory that runs out is a plain error, not an exception's name (a picture the default
+// --max-pixels allows can need more memory than the machine has). Not under the sanitizers,
+// whose shadow memory a limit on the address space leaves no room for.
+#if !defined(SDFC_TEST_ASAN) && !defined(SDFC_TEST_TSAN)
+TEST_CASE("running out of memory is reported as such, exit 1, no output") {
+    const std::string s = test::write_temp("oom.sdf", "sphere(1);\n");
+    const std::string out = test::temp_dir() + "/oom.png";
+    std::remove(out.c_str());
+    auto r = run_sdfc("render '" + s + "' --width 8192 --height 8192 --threads 1 -o '" + out + "'", "ulimit -v 700000;");
+    CHECK(r.status == 1);
+    CHECK(r.err == "sdfc: error: out of memory: the work is too big for this machine (a smaller picture, fewer samples, or lower "
+                   "--max-* limits)\n");
+    CHECK(!fs::exists(out));
+}
+#endif
