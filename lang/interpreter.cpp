@@ -55,7 +55,7 @@ std::string Interp::describe(const Value& v) {
 
 NodeId Interp::checked(NodeId n, Loc loc) {
     if (g->is_const(n) && !std::isfinite(g->const_value(n)))
-        fail(loc, fmt::format("this expression is not a finite number ({})", g->const_value(n)));
+        fail(loc, fmt::format("this expression is not a finite number ({})", shown_number(g->const_value(n))));
     return n;
 }
 

@@ -87,7 +87,11 @@ Scene load_vm(SourceManager&, const SourceFile& file) {
             }
         }
         if (in.op.op == Op::VarZ) uses_z = true;
-        names[std::string(tok[0].first)] = int(instrs->size());
+        // (SSA: a name defined twice is a broken model, not a redefinition)
+        const auto [at, fresh] = names.emplace(std::string(tok[0].first), int(instrs->size()));
+        if (!fresh)
+            throw CompileError(loc(0), fmt::format("'{}' is already defined (line {}): each name is defined once", tok[0].first,
+                                                   (*instrs)[size_t(at->second)].loc.line));
         instrs->push_back(in);
     }
     if (instrs->empty()) throw CompileError(Loc{&file, 1, 1}, "the model has no operations");
@@ -112,7 +116,7 @@ Scene load_vm(SourceManager&, const SourceFile& file) {
             // A folded NaN or infinity (`ln` of -1) is an error on its own line, not on the
             // line of the next operation that uses it.
             if (gr.is_const(v[i]) && !std::isfinite(gr.const_value(v[i])))
-                throw CompileError(in.loc, fmt::format("this operation is not a finite number ({})", gr.const_value(v[i])));
+                throw CompileError(in.loc, fmt::format("this operation is not a finite number ({})", shown_number(gr.const_value(v[i]))));
         }
         return v.back();
     };

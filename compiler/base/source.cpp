@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <fmt/format.h>
+
 #include <mutex>
 #include <optional>
 
@@ -206,5 +208,7 @@ void check_source_text(const SourceFile& f) {
     if (nul != std::string::npos) throw CompileError(loc_of(nul), "binary file: NUL byte in source text");
     if (!valid_utf8(f.text, bad)) throw CompileError(loc_of(bad), "invalid UTF-8 in source text");
 }
+
+std::string shown_number(float v) { return v != v ? std::string("nan") : fmt::format("{}", v); }
 
 }  // namespace sdfc

@@ -37,6 +37,10 @@ struct Diagnostic {
     std::string message;
 };
 
+// A number as a diagnostic shows it: "nan" for any NaN (fmt writes "-nan" when its sign bit
+// is set, which means nothing to a user), "inf", "-inf", else fmt's shortest form.
+std::string shown_number(float v);
+
 // `path:line:col: error: message`, the source line, a caret under the column.
 std::string format_diagnostic(const Diagnostic& d, const char* kind = "error");  // or "warning"
 

@@ -69,7 +69,7 @@ void check_constants(const Program& p) {
         const Instr& in = p.code[i];
         if (op_info(in.op).has_imm && !std::isfinite(in.k))
             throw CompileError(i < p.locs.size() ? p.locs[i] : Loc{},
-                               fmt::format("this expression is not a finite number ({})", in.k));
+                               fmt::format("this expression is not a finite number ({})", shown_number(in.k)));
     }
 }
 

@@ -128,3 +128,17 @@ TEST_CASE("a cone of zero height and radii names its parameters") {
     std::tie(st, msg) = check("cone1.sdf", "cone(1, 0, 0);\n");
     CHECK(st == 0);
 }
+
+TEST_CASE("a .vm name defined twice is an error at the second definition") {
+    std::string vm = test::write_temp("dup.vm", "_0 var-x\n_0 var-y\n");
+    auto r = run_sdfc("check " + q(vm));
+    CHECK(r.status == 1);
+    CHECK(r.err.rfind(vm + ":2:1: error: '_0' is already defined (line 1): each name is defined once\n", 0) == 0);
+}
+
+TEST_CASE("a NaN in a diagnostic reads nan, whatever its sign bit") {
+    std::string vm = test::write_temp("sqrt.vm", "_0 const -1\n_1 sqrt _0\n_2 var-x\n_3 add _1 _2\n");
+    auto r = run_sdfc("check " + q(vm));
+    CHECK(r.status == 1);
+    CHECK(r.err.rfind(vm + ":2:1: error: this operation is not a finite number (nan)\n", 0) == 0);
+}
