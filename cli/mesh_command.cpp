@@ -119,7 +119,12 @@ int cmd_mesh(Args& a) {
         if (!(mo.lo.x < mo.hi.x && mo.lo.y < mo.hi.y && mo.lo.z < mo.hi.z))
             throw UsageError("--bounds needs X0 < X1, Y0 < Y1 and Z0 < Z1");
     } else if (!mesh::default_box(cs, mo.lo, mo.hi, t)) {
-        throw UsageError("the scene is unbounded (a plane, an infinite repetition?): give --bounds X0,Y0,Z0,X1,Y1,Z1");
+        const auto& code = cs.distance.code;
+        const bool reads_point = std::any_of(code.begin(), code.end(), [](const Instr& in) {
+            return in.op == Op::VarX || in.op == Op::VarY || in.op == Op::VarZ;
+        });
+        if (!reads_point) throw std::runtime_error(fmt::format("{} has no surface (its distance is the same everywhere): nothing to mesh", path));
+        throw UsageError("the scene is unbounded (a plane, an infinite repetition, shapes beyond 1e29?): give --bounds X0,Y0,Z0,X1,Y1,Z1");
     }
     const glm::vec3 ext = mo.hi - mo.lo;
     const float longest = std::max({ext.x, ext.y, ext.z});

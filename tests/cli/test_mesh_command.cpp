@@ -63,7 +63,11 @@ TEST_CASE("mesh errors come before the work and change nothing") {
     CHECK(raised.status == 0);  // above the default limit and above what an int holds
     const std::string plane = test::write_temp("mesh_plane.sdf", "plane([0, 1, 0], 0);\n");
     CHECK(run_sdfc("mesh " + q(plane) + " -o a.stl").err ==
-          "sdfc: error: the scene is unbounded (a plane, an infinite repetition?): give --bounds X0,Y0,Z0,X1,Y1,Z1\n");
+          "sdfc: error: the scene is unbounded (a plane, an infinite repetition, shapes beyond 1e29?): give --bounds X0,Y0,Z0,X1,Y1,Z1\n");
+    const std::string empty = test::write_temp("mesh_empty.sdf", "// nothing yet\n");
+    auto none = run_sdfc("mesh " + q(empty) + " -o a.stl");
+    CHECK(none.status == 1);
+    CHECK(none.err == "sdfc: error: " + empty + " has no surface (its distance is the same everywhere): nothing to mesh\n");
     const std::string flat = test::write_temp("mesh_2d.vm", "_0 var-x\n_1 var-y\n_2 square _0\n_3 square _1\n_4 add _2 _3\n");
     CHECK(run_sdfc("mesh " + q(flat) + " -o a.stl").err == "sdfc: error: mesh needs a 3D scene (this one is 2D: render or slice it)\n");
     const std::string out = test::temp_dir() + "/limited.stl";
