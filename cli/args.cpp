@@ -95,7 +95,7 @@ int Args::to_int(const std::string& flag, const std::string& v, long lo, long hi
     char* end = nullptr;
     long x = std::strtol(v.c_str(), &end, 10);
     if (v.empty() || *end != '\0') throw UsageError(fmt::format("{} takes a whole number, not '{}'", flag, v));
-    if (x < lo || x > hi) throw UsageError(fmt::format("{} must be from {} to {}, not {}", flag, lo, hi, x));
+    if (x < lo || x > hi) throw UsageError(fmt::format("{} must be from {} to {}, not {}", flag, lo, hi, v));  // (as typed: strtol clamps)
     return static_cast<int>(x);
 }
 

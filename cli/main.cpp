@@ -53,6 +53,10 @@ std::string image_format_flag(const std::string& out, const std::optional<std::s
     return "";
 }
 
+// What `{name}` stands for: the scene file's name without its folder and extension,
+// "stdin" for a script read from standard input.
+std::string scene_name(const std::string& path) { return path == "-" ? "stdin" : std::filesystem::path(path).stem().string(); }
+
 // `{frame:04d}`, `{frame}` and `{name}` in an output path.
 std::string expand(std::string out, int frame, const std::string& name) {
     auto replace = [&](const std::string& key, const std::string& val) {
@@ -264,7 +268,7 @@ int cmd_render(Args& a) {
         throw UsageError("--aov to standard output needs --format exr (as channels: side files need a file name)");
     // The outputs can be written (folder, format, not a directory...) before any work.
     for (const std::string& path : scenes) {
-        std::string name = std::filesystem::path(path).stem().string();
+        std::string name = scene_name(path);
         for (int f : {f0, f1}) {
             std::string target = expand(*out, f, name);
             check_image_output(target, fmt_ext);
@@ -301,7 +305,7 @@ int cmd_render(Args& a) {
         return true;
     };
     auto todo = [&](size_t scene, int f) {
-        return mine(scene, f) && !(skip_existing && present(expand(*out, f, std::filesystem::path(scenes[scene]).stem().string())));
+        return mine(scene, f) && !(skip_existing && present(expand(*out, f, scene_name(scenes[scene]))));
     };
     if (my_items > 1)
         for (size_t i = 0; i < scenes.size(); ++i)
@@ -320,7 +324,7 @@ int cmd_render(Args& a) {
     const bool tty = !quiet && isatty(fileno(stderr));
     for (size_t scene = 0; scene < scenes.size(); ++scene) {
         const std::string& path = scenes[scene];
-        std::string name = std::filesystem::path(path).stem().string();
+        std::string name = scene_name(path);
         for (int f = f0; f <= f1; ++f) {
             if (!mine(scene, f)) continue;
             std::string target = expand(*out, f, name);
@@ -350,7 +354,12 @@ int cmd_render(Args& a) {
             if (!quiet && f == f0)  // once per scene
                 if (const std::string why = view_problem(cs); !why.empty()) std::fprintf(stderr, "sdfc: warning: %s\n", why.c_str());
             auto t0 = std::chrono::steady_clock::now();
-            Image img = cs.is_2d ? render_2d(cs, cs.render.width, cs.render.height, ro.threads, baseline) : render(cs, ro);
+            Image img;
+            try {
+                img = cs.is_2d ? render_2d(cs, cs.render.width, cs.render.height, ro.threads, baseline) : render(cs, ro);
+            } catch (const std::invalid_argument& e) {  // (render's: options the picture cannot take, --tiles, --aov)
+                throw UsageError(e.what());
+            }
             double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
             if (bar) std::fputs("\r\033[K", stderr), bar = false;
             write_image(target, img, WriteOptions{true, fmt_ext});

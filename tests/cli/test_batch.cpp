@@ -143,7 +143,11 @@ TEST_CASE("render --tiles bands and sdfc merge make the one-render picture, byte
           "sdfc: error: '" + dir + "/one.exr' is a whole picture, not a band of one (render --tiles I/N)\n");
     CHECK(run_sdfc("render " + q(s) + size + " --tiles 0/2 -o " + q(dir + "/p.png")).err ==
           "sdfc: error: --tiles writes a band of the picture as exr (for sdfc merge): -o PART.exr\n");
-    CHECK(run_sdfc("render " + q(s) + size + " --tiles 0/9 -o " + q(dir + "/p.exr")).err ==
-          "sdfc: error: band 0 of 9: the picture has 5 rows of tiles (16 pixels each)\n");
+    auto nine = run_sdfc("render " + q(s) + size + " --tiles 0/9 -o " + q(dir + "/p.exr"));
+    CHECK(nine.status == 2);  // (the command line asks what the picture cannot give)
+    CHECK(nine.err == "sdfc: error: band 0 of 9: the picture has 5 rows of tiles (16 pixels each)\n");
+    auto self = run_sdfc("merge " + q(dir + "/part0.exr") + " -o " + q(dir + "/part0.exr"));
+    CHECK(self.status == 1);
+    CHECK(self.err == "sdfc: error: cannot write '" + dir + "/part0.exr': it is one of the bands merged ('" + dir + "/part0.exr')\n");
     CHECK_FALSE(fs::exists(dir + "/x.png"));
 }

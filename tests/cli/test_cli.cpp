@@ -53,6 +53,17 @@ TEST_CASE("a bad command line exits 2 and a bad script 1, unknown options get di
     CHECK(ok.out == "-1\n");
 }
 
+TEST_CASE("a number out of range is quoted as typed; {name} of standard input is stdin") {
+    std::string s = test::write_temp("range.sdf", "sphere(1);\n");
+    auto r = run_sdfc("render '" + s + "' --width 99999999999999999999 -o '" + test::temp_dir() + "/range.png'");
+    CHECK(r.status == 2);
+    CHECK(r.err == "sdfc: error: --width must be from 1 to 16384, not 99999999999999999999\n");
+    const std::string out = test::temp_dir() + "/{name}.png";
+    auto in = run_sdfc("render - --width 8 --height 8 -q -o '" + out + "'", "", s);
+    CHECK(in.status == 0);
+    CHECK(std::filesystem::exists(test::temp_dir() + "/stdin.png"));
+}
+
 TEST_CASE("eval prints one distance per line") {
     std::string s = test::write_temp("eval.sdf", "sphere(1);\ntranslate([3, 0, 0]) box(2);\n");
     auto r = run_sdfc("eval '" + s + "' --at 0,0,0");
