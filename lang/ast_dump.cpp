@@ -1,4 +1,5 @@
-// `sdfc compile --emit ast`: one node per line, children indented by two spaces.
+// `sdfc compile --emit ast`: one node per line, children indented by two spaces (up to a
+// depth of 40; deeper lines say their depth).
 // Statements end with their position `@line:col`; expressions are listed without positions
 // so that golden listings survive edits that only move code. Labels (`then`, `else`,
 // `callee`, `result`) are lines of their own where the role of a child is not obvious
@@ -10,6 +11,7 @@
 //         vector
 //           number 0.9
 //   ...
+#include <algorithm>
 #include <fmt/format.h>
 
 #include "lang/ast.hpp"
@@ -50,8 +52,12 @@ std::string quote(const std::string& s) {
 struct Dumper {
     std::string out;
 
+    // Past kMaxIndent levels the indent stays put and the line says its depth: deep input
+    // (thousands of nested terms) would otherwise print output quadratic in its size.
+    static constexpr int kMaxIndent = 40;
     void line(int depth, const std::string& text) {
-        out.append(static_cast<size_t>(depth) * 2, ' ');
+        out.append(static_cast<size_t>(std::min(depth, kMaxIndent)) * 2, ' ');
+        if (depth > kMaxIndent) out += fmt::format("[depth {}] ", depth);
         out += text;
         out += '\n';
     }
