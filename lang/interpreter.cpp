@@ -379,8 +379,19 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
                 for (const auto& st : m.stmts)
                     if (st->kind == ast::StmtKind::Let || st->kind == ast::StmtKind::Import) exec(*st, defs, ignored);
             }
-            for (const auto& [name, b] : defs->vars)
-                if (!env->vars.count(name)) env->vars[name] = b;
+            for (const auto& [name, b] : defs->vars) {
+                auto have = env->vars.find(name);
+                if (have == env->vars.end()) {
+                    env->vars[name] = b;
+                    continue;
+                }
+                // The same definition again (a library two imports share) is no conflict;
+                // another of the same name is, as the other order (import, then let) is.
+                const Loc& l = have->second.loc;
+                if (l.file != b.loc.file || l.line != b.loc.line || l.col != b.loc.col)
+                    fail(s.loc, fmt::format("this import defines '{}' ({}:{}), which is already defined in this scope (at line {})", name,
+                                            b.loc.file ? b.loc.file->path : std::string("?"), b.loc.line, l.line));
+            }
             return;
         }
         case ast::StmtKind::Expr:

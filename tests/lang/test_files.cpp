@@ -94,6 +94,20 @@ TEST_CASE("an error in an imported file is reported once, where it is") {
     CHECK(count(e, "error:") == 1);
 }
 
+TEST_CASE("a name both defined and imported is an error in either order; a library imported twice is not") {
+    Folder d;
+    d.write("lib.sdf", "let R = 0.5;\ndef ball() = sphere(R);\n");
+    d.write("let_first.sdf", "let R = 1;\nimport \"lib.sdf\";\nsphere(R);\n");
+    CHECK(d.first_error("let_first.sdf") ==
+          "DIR/let_first.sdf:2:1: error: this import defines 'R' (DIR/lib.sdf:1), which is already defined in this scope (at line 1)");
+    d.write("import_first.sdf", "import \"lib.sdf\";\nlet R = 1;\nsphere(R);\n");
+    CHECK(d.first_error("import_first.sdf") == "DIR/import_first.sdf:2:5: error: 'R' is already defined in this scope (at line 1)");
+    // A diamond: main and big.sdf both import lib.sdf; its names arrive twice, the same.
+    d.write("big.sdf", "import \"lib.sdf\";\ndef big() = scale(2) ball();\n");
+    d.write("diamond.sdf", "import \"lib.sdf\";\nimport \"big.sdf\";\nball();\nbig();\n");
+    CHECK(d.errors("diamond.sdf").empty());
+}
+
 TEST_CASE("import cycles are errors at the import that closes them") {
     Folder d;
     d.write("a.sdf", "import \"b.sdf\";\nsphere(1);\n");
