@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <mutex>
 #include <set>
+#include <sstream>
+#include <string_view>
 #include <thread>
 #include <utility>
 
@@ -149,6 +151,32 @@ void progress_line(const std::string& target, double frac, double elapsed_s, dou
     std::fprintf(stderr, "\r\033[Ksdfc: %s [%s%s] %3d%%%s%s  %.1f s", target.c_str(), std::string(size_t(fill), '#').c_str(),
                  std::string(size_t(width - fill), '.').c_str(), int(frac * 100.0), label.empty() ? "" : " ", label.c_str(), elapsed_s);
     if (eta >= 0.0) std::fprintf(stderr, ", ETA %.1f s", eta);
+}
+
+void read_points(const std::string& path, size_t max_bytes, std::vector<float>& xs, std::vector<float>& ys, std::vector<float>& zs) {
+    // A bad line is an error in an input file: path:line:col, the line and a caret, exit 1.
+    const SourceFile file(path, read_bounded(path, max_bytes));
+    for (uint32_t ln = 1; ln <= file.line_starts.size(); ++ln) {
+        const std::string_view line = file.line(ln);
+        float v[3];
+        size_t pos = 0;
+        int k = 0;
+        for (;; ++k) {
+            pos = line.find_first_not_of(" \t\r", pos);
+            if (pos == std::string_view::npos) break;
+            const size_t end = std::min(line.find_first_of(" \t\r", pos), line.size());
+            std::istringstream ts{std::string(line.substr(pos, end - pos))};
+            float f = 0.0f;
+            if (k == 3 || !(ts >> f) || ts.peek() != std::char_traits<char>::eof())
+                throw CompileError(Loc{&file, ln, uint32_t(pos + 1)}, k == 3 ? "expected three numbers \"x y z\", not more"
+                                                                             : "expected three numbers \"x y z\"");
+            v[k] = f;
+            pos = end;
+        }
+        if (k == 0) continue;  // a blank line
+        if (k < 3) throw CompileError(Loc{&file, ln, uint32_t(line.size() + 1)}, "expected three numbers \"x y z\"");
+        xs.push_back(v[0]); ys.push_back(v[1]); zs.push_back(v[2]);
+    }
 }
 
 }  // namespace sdfc::cli

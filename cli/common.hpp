@@ -38,6 +38,9 @@ CompiledScene build(SourceManager& sm, const std::string& path, Common& c, std::
 std::string view_problem(const CompiledScene& cs);
 // --threads, capped at the machine's hardware threads.
 int thread_count(const std::string& v);
+// `eval --points FILE`: "x y z" a line (blank lines skipped); a bad line is a located error
+// (CompileError: path:line:col, the line, a caret).
+void read_points(const std::string& path, size_t max_bytes, std::vector<float>& xs, std::vector<float>& ys, std::vector<float>& zs);
 // One progress bar line on standard error, redrawn in place; eta < 0: none.
 // Seconds of work before a progress bar shows (1; SDFC_PROGRESS_AFTER sets it, for tests).
 double progress_after_s();

@@ -436,31 +436,7 @@ int cmd_eval(Args& a) {
         auto f = Args::to_floats("--at", *at, 3);
         xs.push_back(f[0]); ys.push_back(f[1]); zs.push_back(f[2]);
     }
-    if (points) {
-        // A bad line is an error in an input file: path:line:col, the line and a caret, exit 1.
-        const SourceFile file(*points, read_bounded(*points, c.interp.limits.max_file_bytes));
-        for (uint32_t ln = 1; ln <= file.line_starts.size(); ++ln) {
-            const std::string_view line = file.line(ln);
-            float v[3];
-            size_t pos = 0;
-            int k = 0;
-            for (;; ++k) {
-                pos = line.find_first_not_of(" \t\r", pos);
-                if (pos == std::string_view::npos) break;
-                const size_t end = std::min(line.find_first_of(" \t\r", pos), line.size());
-                std::istringstream ts{std::string(line.substr(pos, end - pos))};
-                float f = 0.0f;
-                if (k == 3 || !(ts >> f) || ts.peek() != std::char_traits<char>::eof())
-                    throw CompileError(Loc{&file, ln, uint32_t(pos + 1)}, k == 3 ? "expected three numbers \"x y z\", not more"
-                                                                                 : "expected three numbers \"x y z\"");
-                v[k] = f;
-                pos = end;
-            }
-            if (k == 0) continue;  // a blank line
-            if (k < 3) throw CompileError(Loc{&file, ln, uint32_t(line.size() + 1)}, "expected three numbers \"x y z\"");
-            xs.push_back(v[0]); ys.push_back(v[1]); zs.push_back(v[2]);
-        }
-    }
+    if (points) read_points(*points, c.interp.limits.max_file_bytes, xs, ys, zs);
     SourceManager sm;
     CompiledScene cs = build(sm, path, c, time_s ? Args::to_float("--time", *time_s) : 0.0f);
     Evaluator ev(cs.distance);

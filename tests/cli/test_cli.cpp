@@ -53,7 +53,7 @@ TEST_CASE("a bad command line exits 2 and a bad script 1, unknown options get di
     CHECK(ok.out == "-1\n");
 }
 
-TEST_CASE("a number out of range is quoted as typed; {name} of standard input is stdin") {
+TEST_CASE("a number out of range is quoted as typed, and {name} of standard input is stdin") {
     std::string s = test::write_temp("range.sdf", "sphere(1);\n");
     auto r = run_sdfc("render '" + s + "' --width 99999999999999999999 -o '" + test::temp_dir() + "/range.png'");
     CHECK(r.status == 2);

@@ -94,7 +94,7 @@ TEST_CASE("an error in an imported file is reported once, where it is") {
     CHECK(count(e, "error:") == 1);
 }
 
-TEST_CASE("a name both defined and imported is an error in either order; a library imported twice is not") {
+TEST_CASE("a name both defined and imported is an error in either order, but a library imported twice is not") {
     Folder d;
     d.write("lib.sdf", "let R = 0.5;\ndef ball() = sphere(R);\n");
     d.write("let_first.sdf", "let R = 1;\nimport \"lib.sdf\";\nsphere(R);\n");
