@@ -82,6 +82,10 @@ const std::shared_ptr<const Callable>& builtin_callable(Builtin id);
 const BuiltinInfo& builtin_info(Builtin id);
 const std::vector<std::string>& builtin_names();
 
+// After a run without errors: a warning for each name used but bound nowhere in `modules`
+// (code that has not run; lang/unknown_names.cpp).
+void warn_unknown_names(const std::deque<std::unique_ptr<ast::Module>>& modules, std::vector<Diagnostic>& warnings);
+
 class Interp {
 public:
     Interp(SourceManager& sm, const InterpretOptions& opts);

@@ -182,6 +182,7 @@ Scene Interp::run(const SourceFile& file) {
     }
     if (!errors.empty()) throw CompileError(std::move(errors));
     check_defines_used(top);
+    warn_unknown_names(modules, scene.warnings);
     scene.root = union_of(std::move(shapes), Loc{&file, 1, 1});
     return scene;
 }

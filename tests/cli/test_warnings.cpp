@@ -11,6 +11,26 @@ namespace {
 std::string q(const std::string& s) { return "'" + s + "'"; }
 }  // namespace
 
+TEST_CASE("a name bound nowhere, in code that has not run, is a warning with the error's hints") {
+    const std::string lib = test::write_temp("warn_lib.sdf", "def wheel(r) = rotate(x = 90) cylinder(0.2, r);\n");
+    const std::string s = test::write_temp("warn_names.sdf",
+                                           "import \"warn_lib.sdf\";\n"
+                                           "def g() = sphre(1);\n"
+                                           "def h(k) = [for (i = [0 : k]) i * 2];\n"
+                                           "if (false) cube(1);\n"
+                                           "let f = field (p) -> length(p) - 1;\n"
+                                           "wheel(1);\n");
+    auto r = run_sdfc("check " + q(s));
+    CHECK(r.status == 0);
+    CHECK(r.err == s + ":2:11: warning: unknown name 'sphre' (did you mean `sphere`?), in code that has not run (a def never called, "
+                       "a branch not taken)\ndef g() = sphre(1);\n          ^\n" +
+                       s + ":4:12: warning: unknown name 'cube' (sdfc's is `box(size)`, centred on the origin), in code that has not "
+                           "run (a def never called, a branch not taken)\nif (false) cube(1);\n           ^\n");
+    // Every name of a valid script is bound somewhere: no warning.
+    CHECK(run_sdfc("check " + q(test::example("showcase.sdf"))).err.empty());
+    (void)lib;
+}
+
 TEST_CASE("warnings for one-operand CSG, an empty difference and an ignored alpha") {
     const std::string s = test::write_temp("warn.sdf",
                                            "intersection { sphere(1); }\n"

@@ -1,0 +1,96 @@
+// Unknown names in code that never ran (a def never called, a branch not taken): the
+// interpreter resolves names as it runs, so such a typo would wait for the day the code
+// runs. After a run without errors, every name that is used anywhere but bound nowhere
+// (no let, var, def, parameter, for, field parameter in any of the files, no built-in)
+// can only be in code that did not run: a warning, with the same hints as the error.
+#include <string_view>
+#include <unordered_set>
+
+#include <fmt/format.h>
+
+#include "lang/habits.hpp"
+#include "lang/interp.hpp"
+
+namespace sdfc {
+namespace {
+
+class NameWalk {
+public:
+    std::unordered_set<std::string_view> bound;
+    std::vector<const ast::Expr*> uses;  // Ident expressions, in the files' order
+
+    void stmt(const ast::Stmt* s) {
+        if (!s || stack_nearly_exhausted()) return;  // (a lint: deep input just stops it)
+        switch (s->kind) {
+            case ast::StmtKind::Let:
+            case ast::StmtKind::Var:
+            case ast::StmtKind::Def:
+                bound.insert(s->name);
+                break;
+            default:
+                break;
+        }
+        for (const ast::Param& p : s->params) {
+            bound.insert(p.name);
+            expr(p.default_value.get());
+        }
+        bindings(s->bindings);
+        if (s->kind != ast::StmtKind::Import) expr(s->value.get());
+        stmt(s->then_branch.get());
+        stmt(s->else_branch.get());
+        stmt(s->body.get());
+    }
+
+    void expr(const ast::Expr* e) {
+        if (!e || stack_nearly_exhausted()) return;
+        if (e->kind == ast::ExprKind::Ident) uses.push_back(e);
+        if (e->kind == ast::ExprKind::Field) bound.insert(e->text);
+        expr(e->lhs.get());
+        expr(e->rhs.get());
+        for (const auto& x : e->elems) expr(x.get());
+        expr(e->callee.get());
+        for (const ast::Arg& a : e->args) expr(a.value.get());
+        if (e->block) {
+            for (const auto& s : e->block->stmts) stmt(s.get());
+            expr(e->block->result.get());
+        }
+        bindings(e->bindings);
+        expr(e->body.get());
+    }
+
+private:
+    void bindings(const std::vector<ast::ForBinding>& bs) {
+        for (const ast::ForBinding& b : bs) {
+            bound.insert(b.name);
+            expr(b.iterable.get());
+        }
+    }
+};
+
+}  // namespace
+
+void warn_unknown_names(const std::deque<std::unique_ptr<ast::Module>>& modules, std::vector<Diagnostic>& warnings) {
+    NameWalk w;
+    for (const auto& m : modules)
+        for (const auto& s : m->stmts) w.stmt(s.get());
+    static const std::unordered_set<std::string_view> constants = {"time", "pi", "tau", "e"};
+    std::vector<std::string> candidates;
+    for (const ast::Expr* e : w.uses) {
+        const std::string& name = e->text;
+        if (w.bound.count(name) || constants.count(name) || find_builtin(name)) continue;
+        std::string hint = habit_hint(name);
+        if (hint.empty()) {
+            if (candidates.empty()) {
+                candidates = builtin_names();
+                candidates.insert(candidates.end(), w.bound.begin(), w.bound.end());
+                candidates.insert(candidates.end(), constants.begin(), constants.end());
+            }
+            const std::string near = nearest_name(name, candidates);
+            if (!near.empty()) hint = fmt::format(" (did you mean `{}`?)", near);
+        }
+        warnings.push_back({e->loc, fmt::format("unknown name '{}'{}, in code that has not run (a def never called, a branch not "
+                                                "taken)", name, hint)});
+    }
+}
+
+}  // namespace sdfc
