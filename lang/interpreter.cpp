@@ -386,12 +386,14 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
                     env->vars[name] = b;
                     continue;
                 }
-                // The same definition again (a library two imports share) is no conflict;
-                // another of the same name is, as the other order (import, then let) is.
-                const Loc& l = have->second.loc;
-                if (l.file != b.loc.file || l.line != b.loc.line || l.col != b.loc.col)
+                // A let of this file is an error, as the other order (import, then let) is.
+                // A def of this file wins (defs run first, so it did in either order), and
+                // so does the first of two imports.
+                const Binding& h = have->second;
+                const bool same = h.loc.file == b.loc.file && h.loc.line == b.loc.line && h.loc.col == b.loc.col;
+                if (!same && h.loc.file == s.loc.file && h.value.t != VT::Function)
                     fail(s.loc, fmt::format("this import defines '{}' ({}:{}), which is already defined in this scope (at line {})", name,
-                                            b.loc.file ? b.loc.file->path : std::string("?"), b.loc.line, l.line));
+                                            b.loc.file ? b.loc.file->path : std::string("?"), b.loc.line, h.loc.line));
             }
             return;
         }

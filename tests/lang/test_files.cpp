@@ -94,7 +94,7 @@ TEST_CASE("an error in an imported file is reported once, where it is") {
     CHECK(count(e, "error:") == 1);
 }
 
-TEST_CASE("a name both defined and imported is an error in either order, but a library imported twice is not") {
+TEST_CASE("a let both defined and imported is an error in either order, but a library imported twice is not") {
     Folder d;
     d.write("lib.sdf", "let R = 0.5;\ndef ball() = sphere(R);\n");
     d.write("let_first.sdf", "let R = 1;\nimport \"lib.sdf\";\nsphere(R);\n");
@@ -106,6 +106,13 @@ TEST_CASE("a name both defined and imported is an error in either order, but a l
     d.write("big.sdf", "import \"lib.sdf\";\ndef big() = scale(2) ball();\n");
     d.write("diamond.sdf", "import \"lib.sdf\";\nimport \"big.sdf\";\nball();\nbig();\n");
     CHECK(d.errors("diamond.sdf").empty());
+    // A def of the importing file takes the place of the library's; of two libraries, the
+    // first import's R wins.
+    d.write("own_ball.sdf", "import \"lib.sdf\";\ndef ball() = box(1);\nball();\n");
+    CHECK(d.errors("own_ball.sdf").empty());
+    d.write("lib2.sdf", "let R = 2;\n");
+    d.write("two_libs.sdf", "import \"lib.sdf\";\nimport \"lib2.sdf\";\nsphere(R);\n");
+    CHECK(d.errors("two_libs.sdf").empty());
 }
 
 TEST_CASE("import cycles are errors at the import that closes them") {
