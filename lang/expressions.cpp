@@ -52,14 +52,11 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                 return v;
             }
             if (failed_lets.count(e.text)) throw CompileError(std::vector<Diagnostic>{});  // its error is out already
-            if (std::string hint = habit_hint(e.text); !hint.empty()) fail(e.loc, fmt::format("unknown name '{}'{}", e.text, hint));
-            std::vector<std::string> names = builtin_names();
-            for (Env* s = env; s; s = s->parent)
-                for (const auto& [n, b] : s->vars) names.push_back(n);
-            names.insert(names.end(), {"time", "pi", "tau", "e"});
-            std::string near = nearest_name(e.text, names);
-            fail(e.loc, near.empty() ? fmt::format("unknown name '{}'", e.text)
-                                     : fmt::format("unknown name '{}' (did you mean `{}`?)", e.text, near));
+            std::vector<std::string> names;
+            if (habit_hint(e.text).empty())  // (else the names are not needed)
+                for (Env* s = env; s; s = s->parent)
+                    for (const auto& [n, b] : s->vars) names.push_back(n);
+            fail(e.loc, unknown_name_message(e.text, names));
         }
         case K::Vector: {
             std::vector<Value> items;
@@ -271,6 +268,15 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
         }
     }
     fail(e.loc, "internal: unknown expression");
+}
+
+std::string unknown_name_message(const std::string& name, const std::vector<std::string>& names) {
+    if (std::string hint = habit_hint(name); !hint.empty()) return fmt::format("unknown name '{}'{}", name, hint);
+    std::vector<std::string> all = builtin_names();  // (in this order: ties go to the first)
+    all.insert(all.end(), names.begin(), names.end());
+    all.insert(all.end(), std::begin(kConstantNames), std::end(kConstantNames));
+    const std::string near = nearest_name(name, all);
+    return near.empty() ? fmt::format("unknown name '{}'", name) : fmt::format("unknown name '{}' (did you mean `{}`?)", name, near);
 }
 
 Value Interp::call_value(const Value& callee, const std::vector<ast::Arg>& args, Env* env, Loc loc) {

@@ -82,6 +82,12 @@ const std::shared_ptr<const Callable>& builtin_callable(Builtin id);
 const BuiltinInfo& builtin_info(Builtin id);
 const std::vector<std::string>& builtin_names();
 
+// The built-in constants (a let may shadow them).
+inline constexpr std::string_view kConstantNames[] = {"time", "pi", "tau", "e"};
+// "unknown name 'NAME'" and its hint, for the error and for the warning of code that has not
+// run: an OpenSCAD habit's, else the nearest of the built-ins, the constants and `names`.
+std::string unknown_name_message(const std::string& name, const std::vector<std::string>& names);
+
 // After a run without errors: a warning for each name used but bound nowhere in `modules`
 // (code that has not run; lang/unknown_names.cpp).
 void warn_unknown_names(const std::deque<std::unique_ptr<ast::Module>>& modules, std::vector<Diagnostic>& warnings);

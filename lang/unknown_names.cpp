@@ -3,12 +3,10 @@
 // runs. After a run without errors, every name that is used anywhere but bound nowhere
 // (no let, var, def, parameter, for, field parameter in any of the files, no built-in)
 // can only be in code that did not run: a warning, with the same hints as the error.
+#include <algorithm>
 #include <string_view>
 #include <unordered_set>
 
-#include <fmt/format.h>
-
-#include "lang/habits.hpp"
 #include "lang/interp.hpp"
 
 namespace sdfc {
@@ -73,23 +71,12 @@ void warn_unknown_names(const std::deque<std::unique_ptr<ast::Module>>& modules,
     NameWalk w;
     for (const auto& m : modules)
         for (const auto& s : m->stmts) w.stmt(s.get());
-    static const std::unordered_set<std::string_view> constants = {"time", "pi", "tau", "e"};
-    std::vector<std::string> candidates;
+    auto constant = [](std::string_view n) { return std::find(std::begin(kConstantNames), std::end(kConstantNames), n) != std::end(kConstantNames); };
     for (const ast::Expr* e : w.uses) {
         const std::string& name = e->text;
-        if (w.bound.count(name) || constants.count(name) || find_builtin(name)) continue;
-        std::string hint = habit_hint(name);
-        if (hint.empty()) {
-            if (candidates.empty()) {
-                candidates = builtin_names();
-                candidates.insert(candidates.end(), w.bound.begin(), w.bound.end());
-                candidates.insert(candidates.end(), constants.begin(), constants.end());
-            }
-            const std::string near = nearest_name(name, candidates);
-            if (!near.empty()) hint = fmt::format(" (did you mean `{}`?)", near);
-        }
-        warnings.push_back({e->loc, fmt::format("unknown name '{}'{}, in code that has not run (a def never called, a branch not "
-                                                "taken)", name, hint)});
+        if (w.bound.count(name) || constant(name) || find_builtin(name)) continue;
+        warnings.push_back({e->loc, unknown_name_message(name, std::vector<std::string>(w.bound.begin(), w.bound.end())) +
+                                        ", in code that has not run (a def never called, a branch not taken)"});
     }
 }
 
