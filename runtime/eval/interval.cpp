@@ -532,6 +532,37 @@ void IntervalEvaluator::eval(const TapeView& t, const float* xlo, const float* x
     kernels()(t, lo_, hi_, choices_.get(), cv, chain_unknown_, xlo, xhi, ylo, yhi, zlo, zhi, n, m, time);
 }
 
+namespace {
+
+// prune_min_chains' update of one chain min's lanes (see there), in whole rows of 16 lanes
+// (m is a multiple of 16); ok: the lanes to update. Its own function, with restrict
+// pointers and no branch per lane, so that GCC vectorises it.
+void prune_rows(const float* __restrict cv, uint8_t* __restrict chr, const float* __restrict B, float* __restrict ba,
+                float* __restrict bb, const int32_t* __restrict ok, size_t m) {
+    for (size_t j0 = 0; j0 < m; j0 += 16) {
+        alignas(64) int32_t cw[16];
+        for (size_t q = 0; q < 16; ++q) cw[q] = chr[j0 + q];
+        for (size_t q = 0; q < 16; ++q) {
+            const size_t j = j0 + q;
+            const float al = cv[j], ah = cv[m + j], bl = cv[2 * m + j], bh = cv[3 * m + j];
+            const float for_a = mn(bh, B[j]), for_b = mn(ah, B[j]);  // bounds of the rest, seen from a and from b
+            const int32_t c = cw[q], k = ok[j];
+            const int32_t undecided = k & int32_t(c == kChoiceBoth);
+            const int32_t to_b = undecided & int32_t(al > for_a), to_a = undecided & ~to_b & int32_t(bl > for_b);
+            // (arithmetic, not a ternary chain: GCC if-converts this one)
+            const int32_t d = c + to_b * (int32_t(kChoiceB) - c) + to_a * (int32_t(kChoiceA) - c);
+            cw[q] = d;
+            const float xa = ba[j], xb = bb[j], ua = mn(xa, for_a), ub = mn(xb, for_b);
+            const bool wa = (k & int32_t(d != kChoiceB)) != 0, wb = (k & int32_t(d != kChoiceA)) != 0;
+            ba[j] = wa ? ua : xa;
+            bb[j] = wb ? ub : xb;
+        }
+        for (size_t q = 0; q < 16; ++q) chr[j0 + q] = uint8_t(cw[q]);
+    }
+}
+
+}  // namespace
+
 // Top-down over the chain: bound[i] is an upper bound, over the box, of the rest of the
 // chain around Min i (what the output would be without i's value); an operand whose lower
 // bound exceeds min(bound, its sibling's upper bound) can never be the output. Dropping
@@ -548,26 +579,38 @@ void IntervalEvaluator::prune_min_chains(const Tape& t, int n) {
     if (bad == (n == 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1)) return;
     bound_.assign(size_t(t.choices) * m, kInf);  // per choice slot
     uint8_t* choices = choices_.get();
-    auto bound_of = [&](uint32_t d) { return is_chain_min(t.code[d]) ? bound_.data() + size_t(t.links[d].slot) * m : nullptr; };
+    // Lanes to update (known, and not padding), as ints beside the floats: the loop below
+    // then vectorises in whole rows (m is a multiple of 16), without a branch per lane.
+    alignas(64) int32_t ok[kIvLanes];
+    for (size_t j = 0; j < m; ++j) ok[j] = j < size_t(n) && chain_unknown_[j] == 0;
+    // An operand that is not a chain min has no bound: its updates go to a sink row.
+    alignas(64) float sink_a[kIvLanes], sink_b[kIvLanes];
+    auto bound_of = [&](uint32_t d, float* sink) {
+        return is_chain_min(t.code[d]) ? bound_.data() + size_t(t.links[d].slot) * m : sink;
+    };
     for (size_t i = len; i-- > 0;) {
         if (!is_chain_min(t.code[i])) continue;
         const Tape::Link& l = t.links[i];
         const float* cv = chain_.data() + size_t(l.slot) * 4 * m;
-        uint8_t* ch = choices + size_t(l.slot) * m;
+        uint8_t* chr = choices + size_t(l.slot) * m;
         const float* B = bound_.data() + size_t(l.slot) * m;
-        float* Ba = bound_of(l.def[0]);
-        float* Bb = bound_of(l.def[1]);
-        for (int j = 0; j < n; ++j) {
-            if ((bad >> j) & 1) continue;
-            const float al = cv[j], ah = cv[m + j], bl = cv[2 * m + j], bh = cv[3 * m + j];
-            const float for_a = mn(bh, B[j]), for_b = mn(ah, B[j]);  // bounds of the rest, seen from a and from b
-            if (ch[j] == kChoiceBoth) {
-                if (al > for_a) ch[j] = kChoiceB;
-                else if (bl > for_b) ch[j] = kChoiceA;
+        float* Ba = bound_of(l.def[0], sink_a);
+        float* Bb = bound_of(l.def[1], sink_b);
+        if (Ba == Bb) {  // min(x, x), x a chain min: lane by lane (the updates meet)
+            for (int j = 0; j < n; ++j) {
+                if (!ok[j]) continue;
+                const float al = cv[j], ah = cv[m + j], bl = cv[2 * m + j], bh = cv[3 * m + j];
+                const float for_a = mn(bh, B[j]), for_b = mn(ah, B[j]);
+                if (chr[j] == kChoiceBoth) {
+                    if (al > for_a) chr[j] = kChoiceB;
+                    else if (bl > for_b) chr[j] = kChoiceA;
+                }
+                if (chr[j] != kChoiceB) Ba[j] = mn(Ba[j], for_a);
+                if (chr[j] != kChoiceA) Bb[j] = mn(Bb[j], for_b);
             }
-            if (Ba && ch[j] != kChoiceB) Ba[j] = mn(Ba[j], for_a);
-            if (Bb && ch[j] != kChoiceA) Bb[j] = mn(Bb[j], for_b);
+            continue;
         }
+        prune_rows(cv, chr, B, Ba, Bb, ok, m);
     }
 }
 
