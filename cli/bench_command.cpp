@@ -20,6 +20,7 @@ int cmd_bench(Args& a) {
     auto warmup = a.value("--warmup");
     auto threads = a.value("--threads");
     bool baseline = a.flag("--baseline");
+    bool fresh_tree = a.flag("--fresh-tree");
     Overrides ov = read_overrides(a);
     std::string path = one_scene(a, "bench");
     int n = repeat ? Args::to_int("--repeat", *repeat, 1, 100000) : 5;
@@ -30,6 +31,9 @@ int cmd_bench(Args& a) {
     RenderOptions ro;
     if (threads) ro.threads = thread_count(*threads);
     ro.baseline = baseline;
+    // Every render builds its own tape tree (the cost of one picture), instead of taking the
+    // one the render before kept (frames of an animation: runtime/cpu/tree_cache.hpp).
+    ro.reuse_tree = !fresh_tree;
     // The first renders of a process pay for fresh memory (page faults on the picture and
     // scratch: twice with glibc, whose first large block is mapped, freed, and then taken
     // from the heap) and thread start-up: --warmup of them run untimed (as hyperfine's
@@ -61,13 +65,13 @@ int cmd_bench(Args& a) {
     auto per = [&](uint64_t v) { return double(v) / pixels; };
     const auto& by = stats.distance_points_by;
     std::printf("median_ms=%.3f min_ms=%.3f cold_ms=%.3f evals_per_pixel=%.2f rays=%.2f normals=%.2f shadows=%.2f ao=%.2f "
-                "shading=%.2f tape=%.0f/%zu tree_leaves=%llu tree_ms=%.1f skips=%.2f segment_skips=%.2f tile_skips=%llu shadow_cuts=%llu "
+                "shading=%.2f tape=%.0f/%zu tree_leaves=%llu tree_ms=%.1f tree_reused=%d skips=%.2f segment_skips=%.2f tile_skips=%llu shadow_cuts=%llu "
                 "isa=%s\n",
                 median, sorted.front(), cold, per(stats.distance_points), per(by[RenderStats::kRays]),
                 per(by[RenderStats::kNormals]), per(by[RenderStats::kShadows]), per(by[RenderStats::kAo]),
                 per(stats.shading_points),
                 stats.distance_points ? double(stats.distance_instructions) / double(stats.distance_points) : 0.0,
-                cs.distance.code.size(), static_cast<unsigned long long>(stats.tree_leaves), stats.tree_ms, per(stats.skips), per(stats.segment_skips),
+                cs.distance.code.size(), static_cast<unsigned long long>(stats.tree_leaves), stats.tree_ms, int(stats.tree_reused), per(stats.skips), per(stats.segment_skips),
                 static_cast<unsigned long long>(stats.tile_skips), static_cast<unsigned long long>(stats.shadow_cuts),
                 isa_name(current_isa()));
     return 0;

@@ -161,10 +161,12 @@ std::vector<CommandSpec> make_commands() {
                           {"--warmup", "", "N", "", "2", "untimed renders first (their one-time costs: fresh memory, thread start-up)"},
                           threads,
                           baseline,
+                          {"--fresh-tree", "", "", "", "",
+                           "every render builds its own tape tree (one picture's cost), instead of taking the one the render before kept, as the frames of an animation do"},
                       },
                       render_settings()),
                  "Prints median_ms, min_ms (of the timed renders), cold_ms (the process's first render), evals_per_pixel (SDF evaluations: rays, normals, shadows, ao), shading (material "
-                 "evaluations), the mean program length run (tape=MEAN/FULL), the tape tree and the kernels' instruction set (isa).",
+                 "evaluations), the mean program length run (tape=MEAN/FULL), the tape tree (tree_reused=1: kept from the render before) and the kernels' instruction set (isa).",
                  true});
     c.push_back({"watch", "[--runs N] [--debounce MS] CMD ARGS...", "run a command again on every save of its scene or an import",
                  {

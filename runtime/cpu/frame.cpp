@@ -46,7 +46,9 @@ Frame make_frame(const CompiledScene& scene, const RenderOptions& options) {
     f.view = options.view;
     f.has_distance = !scene.distance.outputs.empty();
     f.has_material = scene.shading.outputs.size() >= static_cast<size_t>(1 + kMatOut);
-    f.tree.init_full(scene.distance);
+    auto full = std::make_shared<TapeTree>();
+    full->init_full(scene.distance);
+    f.tree = std::move(full);
     if (f.has_material) f.shade_code = live_code(scene.shading, 1);
     return f;
 }

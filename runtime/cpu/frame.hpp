@@ -4,6 +4,7 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -30,7 +31,9 @@ struct Frame : RenderPlan {
     bool want_depth = false, want_normal = false, want_steps = false;
     bool alpha = false;  // RenderOptions::alpha: the image has a coverage channel
     RenderView view = RenderView::Shaded;
-    TapeTree tree;                  // leaf 0 (the full distance program) at least
+    // Leaf 0 (the full distance program) at least; shared with other renders when kept
+    // (tree_cache.hpp), and read-only once built.
+    std::shared_ptr<const TapeTree> tree;
     uint32_t max_regs = 1;          // registers of the longest distance tape: sizes the workers' VMs
     std::vector<Instr> shade_code;  // the shading program without the distance output's code
 
@@ -43,7 +46,7 @@ struct Frame : RenderPlan {
 
     Frame(const CompiledScene& s, RenderPlan p)
         : RenderPlan(std::move(p)), scene(&s), camera(s.camera, std::max(s.render.width, 1), std::max(s.render.height, 1)) {}
-    Frame(Frame&&) = default;       // (a copy would leave the tree's leaves pointing into the original's tapes)
+    Frame(Frame&&) = default;
     Frame(const Frame&) = delete;
 
     float thr(float path) const { return rules::sdf_thr(eps, path); }

@@ -71,6 +71,7 @@ struct TapeTree {
     std::vector<uint32_t> ropes;
     std::vector<Leaf> leaves;
     std::vector<std::vector<Instr>> tapes;  // [0]: the full program
+    std::vector<Guard> guards;  // the full program's (leaf 0's): the tree outlives the program it was built from (tree_cache.hpp)
     uint32_t max_regs = 1;
     uint64_t boxes = 0;
     bool active = false;
@@ -78,9 +79,10 @@ struct TapeTree {
     // Leaf 0 only: the full program everywhere.
     void init_full(const Program& p) {
         tapes.assign(1, p.code);
+        guards = p.guards;
         constexpr float inf = INFINITY;
         leaves.assign(1, Leaf{{inf, inf, inf}, {-inf, -inf, -inf}, -inf, inf, tapes[0].data(), static_cast<uint32_t>(tapes[0].size()),
-                              p.outputs.empty() ? uint16_t(0) : p.outputs[0], 0, 0, p.guards.empty() ? nullptr : p.guards.data()});
+                              p.outputs.empty() ? uint16_t(0) : p.outputs[0], 0, 0, guards.empty() ? nullptr : guards.data()});
         max_regs = std::max<uint32_t>(p.num_regs, 1);
         nodes.clear();
         boxes_.clear();

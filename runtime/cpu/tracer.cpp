@@ -19,6 +19,7 @@
 #include "runtime/cpu/frame.hpp"
 #include "runtime/cpu/slice.hpp"
 #include "runtime/cpu/tape_tree.hpp"
+#include "runtime/cpu/tree_cache.hpp"
 #include "runtime/cpu/worker.hpp"
 
 namespace sdfc {
@@ -156,14 +157,17 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
     const int threads = options.threads > 0 ? options.threads : tbb::task_arena::automatic;
     tbb::task_arena arena(threads);
     double tree_ms = 0.0;
+    bool tree_reused = false;
     arena.execute([&] {
         if (want_tree) {
             const auto t0 = Clock::now();
-            const size_t samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(f.samples);
-            cpu::build_tree(f.tree, scene.distance, root_lo, root_hi, f.time, !f.raw, samples, thin_layer);
+            cpu::TreeInputs in;
+            in.lo = root_lo, in.hi = root_hi, in.time = f.time, in.lipschitz = !f.raw, in.thin_layer = thin_layer;
+            in.samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(f.samples);
+            f.tree = cpu::shared_tree(scene.distance, in, options.reuse_tree, &tree_reused);
             tree_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
         }
-        f.max_regs = std::max<uint32_t>(f.tree.max_regs, std::max<uint32_t>(scene.distance.num_regs, 1));
+        f.max_regs = std::max<uint32_t>(f.tree->max_regs, std::max<uint32_t>(scene.distance.num_regs, 1));
     });
 
     tbb::enumerable_thread_specific<std::unique_ptr<cpu::Worker>> workers;
@@ -177,9 +181,10 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
         *stats = RenderStats{};
         for (auto& w : workers)
             if (w) merge(*stats, w->stats);
-        stats->tree_leaves = f.tree.active ? f.tree.leaves.size() - 1 : 0;
-        stats->interval_boxes = f.tree.boxes;
+        stats->tree_leaves = f.tree->active ? f.tree->leaves.size() - 1 : 0;
+        stats->interval_boxes = tree_reused ? 0 : f.tree->boxes;
         stats->tree_ms = tree_ms;
+        stats->tree_reused = tree_reused;
     }
     return img;
 }

@@ -62,6 +62,10 @@ struct RenderOptions {
     // Plain Hart sphere tracing on the full program: no tape tree (pruning, empty-space
     // skipping), no over-relaxation, no bounding-box clipping (`--baseline`, for measuring).
     bool baseline = false;
+    // Keep the tape tree for the next render that would build the same one, and take the
+    // kept one when it is (runtime/cpu/tree_cache.hpp: the same pixels either way; off,
+    // every render builds its own). Renders of other scenes replace it.
+    bool reuse_tree = true;
     // Called about every 0.1 s while tiles finish, from whichever render thread finished
     // one (never two calls at once), and once at the end with tiles_done == tiles_total
     // from the calling thread. Must not throw.
@@ -86,7 +90,8 @@ struct RenderStats {
     uint64_t shadow_cuts = 0;  // a raw field's shadow ray sets cut short (raw_shadow_cut)
     uint64_t segment_skips = 0;  // of skips: a raw field's rays through cells not empty (segment_bounds)
     uint64_t tree_leaves = 0, interval_boxes = 0;
-    double tree_ms = 0.0;
+    double tree_ms = 0.0;       // building the tree, or finding the kept one
+    bool tree_reused = false;   // the tree was the one kept from an earlier render (RenderOptions::reuse_tree)
 };
 
 // The names render() accepts in RenderOptions::aovs.

@@ -22,7 +22,7 @@ constexpr int kConeEvents = 4;  // partial hits a cone composites (cone_march)
 
 class Worker {
 public:
-    explicit Worker(const Frame& f) : f_(f), T_(f.tree), dist_(f.max_regs) {
+    explicit Worker(const Frame& f) : f_(f), T_(*f.tree), dist_(f.max_regs) {
         if (f.has_material) shade_ = std::make_unique<BatchVM>(f.scene->shading.num_regs);
         lanes_ = std::make_unique<Lanes>();
         buckets_ = std::make_unique<Buckets>();

@@ -15,6 +15,7 @@
 #include "runtime/cpu/frame.hpp"
 #include "runtime/cpu/tape_tree.hpp"
 #include "runtime/cpu/tracer.hpp"
+#include "runtime/cpu/tree_cache.hpp"
 #include "runtime/eval/interval.hpp"
 #include "support.hpp"
 
@@ -444,6 +445,7 @@ TEST_CASE("accel: an empty leaf's biggest empty ancestor, and every node's least
 TEST_CASE("accel: identical pixels for any thread count, with the tree", "[accel][determinism]") {
     auto c = test::compile_text(grid_scene(9, 96, 64));
     RenderOptions ro;
+    ro.reuse_tree = false;  // each render builds its tree with its own thread count
     ro.threads = 1;
     RenderStats s1;
     const Image a = render(c->cs, ro, &s1);
@@ -456,6 +458,46 @@ TEST_CASE("accel: identical pixels for any thread count, with the tree", "[accel
         CHECK(st.distance_points == s1.distance_points);
         CHECK(st.tree_leaves == s1.tree_leaves);
     }
+}
+
+TEST_CASE("accel: a render takes the tree the render before kept only when it would build the same one", "[accel][reuse]") {
+    cpu::forget_tree();
+    RenderOptions ro;
+    ro.threads = 2;
+    RenderStats s1, s2, s3, s4, s5;
+    Image first(1, 1, 3);
+    {
+        auto c1 = test::compile_text(grid_scene(9, 96, 64));
+        first = render(c1->cs, ro, &s1);
+        CHECK_FALSE(s1.tree_reused);
+        REQUIRE(s1.tree_leaves > 0);
+    }  // (the program the kept tree was built from is gone)
+    auto c2 = test::compile_text(grid_scene(9, 96, 64));
+    const Image again = render(c2->cs, ro, &s2);
+    CHECK(s2.tree_reused);
+    CHECK(s2.interval_boxes == 0);
+    CHECK(again.pixels == first.pixels);
+    CHECK(s2.distance_points == s1.distance_points);
+    CHECK(s2.tree_leaves == s1.tree_leaves);
+    // Other lights and materials: the same distance program, the same tree.
+    auto lit = test::compile_text("light(position = [-6, 10, 4], intensity = 80);\n" + grid_scene(9, 96, 64));
+    render(lit->cs, ro, &s3);
+    CHECK(s3.tree_reused);
+    // Another picture size (the tree's budgets) or another scene: a tree of its own.
+    c2->cs.render.width = 80;
+    render(c2->cs, ro, &s4);
+    CHECK_FALSE(s4.tree_reused);
+    auto other = test::compile_text(grid_scene(8, 80, 64));
+    render(other->cs, ro, &s5);
+    CHECK_FALSE(s5.tree_reused);
+    // Off: built again, the same pixels.
+    ro.reuse_tree = false;
+    RenderStats s6;
+    auto c3 = test::compile_text(grid_scene(9, 96, 64));
+    const Image fresh = render(c3->cs, ro, &s6);
+    CHECK_FALSE(s6.tree_reused);
+    CHECK(fresh.pixels == first.pixels);
+    cpu::forget_tree();
 }
 
 TEST_CASE("accel: progress is reported, last with every tile done", "[accel][progress]") {
