@@ -251,6 +251,13 @@ namespace {
 struct IterItem {
     Value v;
 };
+
+// Where an earlier definition is, for a message about a later one at `here`: its line, and
+// its file when that is another (an imported name).
+std::string where_defined(const Loc& earlier, const Loc& here) {
+    if (earlier.file == here.file || !earlier.file) return fmt::format("at line {}", earlier.line);
+    return fmt::format("at {}:{}", earlier.file->path, earlier.line);
+}
 }  // namespace
 
 void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
@@ -287,7 +294,7 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
                 fail(s.name_loc, fmt::format("'{}' is a built-in name and cannot be redefined", s.name));
             auto it = env->vars.find(s.name);
             if (it != env->vars.end())
-                fail(s.name_loc, fmt::format("'{}' is already defined in this scope (at line {})", s.name, it->second.loc.line));
+                fail(s.name_loc, fmt::format("'{}' is already defined in this scope ({})", s.name, where_defined(it->second.loc, s.name_loc)));
             Value v;
             bool defined = false;
             if (env == main_env && s.kind == ast::StmtKind::Let)
@@ -327,7 +334,7 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
                 fail(s.name_loc, fmt::format("'{}' is a built-in name and cannot be redefined", s.name));
             auto it = env->vars.find(s.name);
             if (it != env->vars.end())
-                fail(s.name_loc, fmt::format("'{}' is already defined in this scope (at line {})", s.name, it->second.loc.line));
+                fail(s.name_loc, fmt::format("'{}' is already defined in this scope ({})", s.name, where_defined(it->second.loc, s.name_loc)));
             for (size_t i = 0; i < s.params.size(); ++i)
                 for (size_t j = 0; j < i; ++j)
                     if (s.params[i].name == s.params[j].name)

@@ -349,11 +349,17 @@ Bounds bounds_ChamferDifference(const BoundsIn& b) { return first(b); }
 // --- stairs: hg_sdf's fOpUnionStairs; intersection and difference by negation.
 
 namespace {
+// r <= 0 is the hard union, as for the smooth and chamfer operations (the steps' width r / n
+// would be 0: a modulo by 0, NaN everywhere); a size known only when the program runs
+// (time) chooses between the two.
 NodeId stairs_union(L& l, NodeId a, NodeId b, NodeId r, NodeId n) {
+    const bool known = l.g.is_const(r);
+    if (known && !(l.g.const_value(r) > 0.0f)) return l.mn(a, b);
     NodeId s = l.div(r, n);
     NodeId u = l.sub(b, r);
     NodeId m = l.g.binary(Op::Mod, l.add(l.sub(u, a), s), l.mul(l.c(2), s));
-    return l.mn(l.mn(a, b), l.mul(l.c(0.5f), l.add(l.add(u, a), l.abs(l.sub(m, s)))));
+    NodeId d = l.mn(l.mn(a, b), l.mul(l.c(0.5f), l.add(l.add(u, a), l.abs(l.sub(m, s)))));
+    return known ? d : l.sel(l.lt(l.c(0), r), d, l.mn(a, b));
 }
 }  // namespace
 

@@ -82,6 +82,10 @@ void add_operation_cases(std::vector<Case>& out) {
     s.script("stairs_intersection(0.5, 3) { sphere(1); translate([1, 0, 0]) sphere(1); }")
         .at(0.5, 0.3f, 0, -stairs(-(std::sqrt(0.25 + 0.09) - 1), -(std::sqrt(0.25 + 0.09) - 1), 0.5, 3));
     s.script("stairs_difference(0.5, 3) { sphere(1); translate([1, 0, 0]) sphere(1); }").less(-0.9f, 0, 0, 0).greater(0.9f, 0, 0, 0);
+    // No size: the hard operations (as smooth and chamfer), not steps of width 0 (NaN).
+    s.script("stairs_union(0, 3) { box(2); translate([0, 1.5, 0]) box(1); }").at(0, 0, 0, -1).at(0, 1.5f, 0, -0.5f).at(3, 0, 0, 2);
+    s.script("stairs_intersection(0, 3) { box(2); translate([0.5, 0, 0]) box(2); }").at(0, 0, 0, -0.5f);
+    s.script("stairs_difference(0, 3) { box(2); translate([2, 0, 0]) box(2); }").at(-0.5f, 0, 0, -0.5f);
 
     // translate, rotate, scale, mirror. rotate(x=, y=, z=) in degrees, x first, then y, then z.
     s.script("translate([1, 2, 3]) sphere(1);").at(1, 2, 3, -1);

@@ -101,7 +101,7 @@ TEST_CASE("a let both defined and imported is an error in either order, but a li
     CHECK(d.first_error("let_first.sdf") ==
           "DIR/let_first.sdf:2:1: error: this import defines 'R' (DIR/lib.sdf:1), which is already defined in this scope (at line 1)");
     d.write("import_first.sdf", "import \"lib.sdf\";\nlet R = 1;\nsphere(R);\n");
-    CHECK(d.first_error("import_first.sdf") == "DIR/import_first.sdf:2:5: error: 'R' is already defined in this scope (at line 1)");
+    CHECK(d.first_error("import_first.sdf") == "DIR/import_first.sdf:2:5: error: 'R' is already defined in this scope (at DIR/lib.sdf:1)");
     // A diamond: main and big.sdf both import lib.sdf; its names arrive twice, the same.
     d.write("big.sdf", "import \"lib.sdf\";\ndef big() = scale(2) ball();\n");
     d.write("diamond.sdf", "import \"lib.sdf\";\nimport \"big.sdf\";\nball();\nbig();\n");
