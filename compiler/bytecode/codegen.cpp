@@ -1,5 +1,6 @@
-// IR Graph -> register Program: instruction selection (immediate forms, MulAddI fusion),
-// then linear-scan register allocation in SSA order (the policy of regalloc.hpp).
+// IR Graph -> register Program: instruction selection (immediate forms, MulAddI and
+// Length2I/3I fusion), then linear-scan register allocation in SSA order (the policy of
+// regalloc.hpp).
 #include <algorithm>
 #include <limits>
 
@@ -42,7 +43,8 @@ struct Sel {
 namespace {
 
 // Instruction selection over the live nodes: immediate forms, then Add(MulI(x), y) fused to
-// MulAddI where the MulI has no other use (`extra_uses`: uses by guards).
+// MulAddI and AddI(Length2/3) to Length2I/3I where the inner op has no other use
+// (`extra_uses`: uses by guards).
 std::vector<Sel> select(const Graph& g, const std::vector<uint8_t>& live, const std::vector<NodeId>& roots,
                         const std::vector<NodeId>& extra_uses) {
     const size_t n = g.size();
@@ -85,6 +87,14 @@ std::vector<Sel> select(const Graph& g, const std::vector<uint8_t>& live, const 
                 break;
             }
         }
+    }
+    // AddI(Length2/3(...)) -> Length2I/3I: a sphere's or a torus's distance in one instruction.
+    for (size_t i = 0; i < n; ++i) {
+        Sel& s = sel[i];
+        if (!s.emit || s.op != Op::AddI || s.a == kNoNode) continue;
+        const Sel& m = sel[s.a];
+        if (!m.emit || uses[s.a] != 1 || (m.op != Op::Length2 && m.op != Op::Length3)) continue;
+        s = Sel{m.op == Op::Length2 ? Op::Length2I : Op::Length3I, m.a, m.b, m.c, s.k, true};
     }
     count_uses(uses);
     for (size_t i = 0; i < n; ++i)

@@ -80,6 +80,15 @@ std::string guard_case(bool wide) {
         static_cast<int>(Op::Guard), read, wide ? 2 : 4);
 }
 
+// An instruction has room for three operands or two and k: length3_i (three and k) goes as
+// length3 into its output register, then add_i of k there (the same two roundings).
+constexpr bool only_length3i_has_four() {
+    for (int i = 0; i < kOpCount; ++i)
+        if (kOpInfo[i].arity == 3 && kOpInfo[i].has_imm && i != static_cast<int>(Op::Length3I)) return false;
+    return true;
+}
+static_assert(only_length3i_has_four(), "pack_tapes splits length3_i only");
+
 }  // namespace
 
 PackedTapes pack_tapes(const std::vector<const Program*>& programs) {
@@ -93,13 +102,33 @@ PackedTapes pack_tapes(const std::vector<const Program*>& programs) {
     uint32_t n = 0;
     for (const Program* p : programs) {
         std::vector<uint32_t> at(p->code.size() + 1);
-        for (size_t i = 0; i < p->code.size(); ++i) at[i] = n, n += p->code[i].op == Op::Guard ? guard_size : 1;
+        for (size_t i = 0; i < p->code.size(); ++i)
+            at[i] = n, n += p->code[i].op == Op::Guard ? guard_size : (p->code[i].op == Op::Length3I ? 2 : 1);
         at[p->code.size()] = n;
         TapeSegment seg;
         seg.begin = at[0];
         seg.end = n;
+        auto put = [&](const Instr& in) {
+            used[static_cast<int>(in.op)] = true;
+            const bool imm = op_info(in.op).has_imm;
+            const uint32_t last = imm ? bits(in.k) : in.c;
+            if (t.wide) {
+                t.words.insert(t.words.end(), {static_cast<uint32_t>(in.op), in.out, uint32_t(in.a) | uint32_t(in.b) << 16, last});
+            } else {
+                t.words.push_back(static_cast<uint32_t>(in.op) | uint32_t(in.out) << 8 | uint32_t(in.a) << 16 | uint32_t(in.b) << 24);
+                t.words.push_back(last);
+            }
+        };
         for (size_t i = 0; i < p->code.size(); ++i) {
             const Instr& in = p->code[i];
+            if (in.op == Op::Length3I) {
+                Instr len = in, add{Op::AddI};
+                len.op = Op::Length3, len.k = 0.0f;
+                add.out = add.a = in.out, add.k = in.k;
+                put(len);
+                put(add);
+                continue;
+            }
             used[static_cast<int>(in.op)] = true;
             if (in.op == Op::Guard) {
                 const Guard& gd = p->guards.at(guard_index(in));
@@ -115,14 +144,7 @@ PackedTapes pack_tapes(const std::vector<const Program*>& programs) {
                 }
                 continue;
             }
-            const bool imm = op_info(in.op).has_imm;
-            const uint32_t last = imm ? bits(in.k) : in.c;
-            if (t.wide) {
-                t.words.insert(t.words.end(), {static_cast<uint32_t>(in.op), in.out, uint32_t(in.a) | uint32_t(in.b) << 16, last});
-            } else {
-                t.words.push_back(static_cast<uint32_t>(in.op) | uint32_t(in.out) << 8 | uint32_t(in.a) << 16 | uint32_t(in.b) << 24);
-                t.words.push_back(last);
-            }
+            put(in);
         }
         seg.outputs = p->outputs;
         t.segments.push_back(std::move(seg));

@@ -295,6 +295,22 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
             lo = mx(lo, 0.0f);
             break;
         }
+        case Op::Length2I:
+        case Op::Length3I: {
+            // Length2 / Length3's interval (a zero c for Length2), then AddI's: the rounding
+            // of the VM's add is monotonic, so the ends' sums bound it.
+            const bool three = O == Op::Length3I;
+            float a0 = al >= 0.0f ? al : (ah <= 0.0f ? -ah : 0.0f), a1 = mx(-al, ah);
+            float b0 = bl >= 0.0f ? bl : (bh <= 0.0f ? -bh : 0.0f), b1 = mx(-bl, bh);
+            float c0 = !three ? 0.0f : (cl >= 0.0f ? cl : (ch <= 0.0f ? -ch : 0.0f)), c1 = !three ? 0.0f : mx(-cl, ch);
+            float l0 = mx(dn(std::sqrt(a0 * a0 + b0 * b0 + c0 * c0)), 0.0f);
+            float l1 = up(std::sqrt(a1 * a1 + b1 * b1 + c1 * c1));
+            lo = l0 + k;
+            hi = l1 + k;
+            z += opposite_infinities(l0, l1, k, k) ? kNaN : 0.0f;
+            z += std::isnan(k) ? kNaN : 0.0f;
+            break;
+        }
         case Op::AddI:
             lo = al + k;
             hi = ah + k;
