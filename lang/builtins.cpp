@@ -463,6 +463,7 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
         return v;
     }
     // Settings
+    note_setting_in_target(info, loc);
     auto once = [&](Loc& at, const char* what) {
         if (at.known()) fail(loc, fmt::format("a second {} statement (the first is at line {})", what, at.line));
         at = loc;

@@ -295,7 +295,7 @@ Value Interp::call_value(const Value& callee, const std::vector<ast::Arg>& args,
     }
     if (callee.t == VT::Modifier && args.size() == 1 && args[0].name.empty()) {
         // `translate(v) (k > 1 ? a : b)`: the parenthesised target reads as a call.
-        Value t = eval(*args[0].value, env);
+        Value t = eval_target(*args[0].value, env, callee.mod->name);
         ShapePtr target = to_shape(t, args[0].loc, fmt::format("the target of {}", callee.mod->name).c_str());
         return Value::of_shape(apply_modifier(*callee.mod, target, loc));
     }
@@ -376,7 +376,7 @@ Value Interp::apply(const ast::Expr& e, Env* env) {
     if (e.lhs->kind == ast::ExprKind::Call) {
         const Value callee = eval(*e.lhs->callee, env);
         if (callee.t == VT::Function && !callee.fn->builtin && callee.fn->def && leaves_last_to_target(*callee.fn, e.lhs->args)) {
-            const Value t = eval(*e.rhs, env);
+            const Value t = eval_target(*e.rhs, env, callee.fn->name);
             const Value target = Value::of_shape(to_shape(t, e.rhs->loc, fmt::format("the target of {}", callee.fn->name).c_str()));
             Value r = call_user(*callee.fn, e.lhs->args, env, e.lhs->loc, &target);
             if (r.t != VT::Shape)
@@ -405,9 +405,32 @@ Value Interp::apply(const ast::Expr& e, Env* env) {
     if (m.t != VT::Modifier)
         fail(e.lhs->loc, fmt::format("{} is written before a shape but is not an operation{}", describe(m),
                                      m.t == VT::Shape ? " (is a ';' missing after it?)" : ""));
-    Value t = eval(*e.rhs, env);
+    Value t = eval_target(*e.rhs, env, m.mod->name);
     ShapePtr target = to_shape(t, e.rhs->loc, fmt::format("the target of {}", m.mod->name).c_str());
     return Value::of_shape(apply_modifier(*m.mod, target, e.loc));
+}
+
+Value Interp::eval_target(const ast::Expr& target, Env* env, const std::string& op) {
+    struct On {
+        std::vector<std::string>& v;
+        ~On() { v.pop_back(); }
+    } on{targets};
+    targets.push_back(op);
+    return eval(target, env);
+}
+
+// A light or camera (any setting) written inside an operation's target is set as written:
+// the operation applies to shapes only. A warning, not again right after itself (a loop).
+void Interp::note_setting_in_target(const BuiltinInfo& info, Loc loc) {
+    if (targets.empty()) return;
+    const std::string msg = fmt::format("{}(...) is inside the target of {}, which applies to shapes only: the {} is set as written, "
+                                        "not moved, turned or scaled (write it outside the operation)",
+                                        info.name, targets.back(), info.name);
+    if (!scene.warnings.empty()) {
+        const Diagnostic& d = scene.warnings.back();
+        if (d.loc.file == loc.file && d.loc.line == loc.line && d.loc.col == loc.col && d.message == msg) return;
+    }
+    scene.warnings.push_back({loc, msg});
 }
 
 // ---------------------------------------------------------------- operators

@@ -117,6 +117,11 @@ public:
     // fresh scope; enforces the loop limits.
     void run_for(const std::vector<ast::ForBinding>& bindings, Env* env, Loc loc, const std::function<void(Env*)>& body);
     ShapePtr to_shape(const Value& v, Loc loc, const char* what);
+    // The target of an operation (`translate(v) ...`), evaluated with the operation's name
+    // on `targets` (a setting there warns: no operation moves a light or the camera).
+    Value eval_target(const ast::Expr& target, Env* env, const std::string& op);
+    std::vector<std::string> targets;
+    void note_setting_in_target(const BuiltinInfo& info, Loc loc);
     ShapePtr union_of(std::vector<ShapePtr> shapes, Loc loc);
     ShapePtr choose(NodeId cond, ShapePtr a, ShapePtr b, Loc loc);  // a Choose shape (cond on time alone)
 

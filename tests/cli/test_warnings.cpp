@@ -55,6 +55,22 @@ TEST_CASE("warnings for one-operand CSG, an empty difference and an ignored alph
     CHECK(n == 1);
 }
 
+TEST_CASE("a light or camera inside an operation's target is a warning: operations move shapes only") {
+    const std::string s = test::write_temp("warn_setting.sdf",
+                                           "sphere(1);\n"
+                                           "for (i = [0 : 3]) translate([i, 0, 0]) { light(position = [5, 0, 5], intensity = 30); }\n"
+                                           "mirror([1, 0, 0]) camera(position = [0, 0, 6]);\n");
+    auto r = run_sdfc("check " + q(s));
+    CHECK(r.status == 0);
+    CHECK(r.err == s + ":2:42: warning: light(...) is inside the target of translate, which applies to shapes only: the light is set "
+                       "as written, not moved, turned or scaled (write it outside the operation)\n"
+                       "for (i = [0 : 3]) translate([i, 0, 0]) { light(position = [5, 0, 5], intensity = 30); }\n"
+                       "                                         ^\n" +
+                       s + ":3:19: warning: camera(...) is inside the target of mirror, which applies to shapes only: the camera is set "
+                           "as written, not moved, turned or scaled (write it outside the operation)\n"
+                           "mirror([1, 0, 0]) camera(position = [0, 0, 6]);\n                  ^\n");
+}
+
 // Measured on NVIDIA's driver (580, an H200): an array constructor of more than 1,024 uvec4s
 // fails to compile, so a Shadertoy or GLSL 330 shader whose tape is bigger says so.
 TEST_CASE("glsl warns when a tape is too big for NVIDIA's constant arrays, and only then") {
