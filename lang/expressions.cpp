@@ -61,23 +61,40 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
         case K::Vector: {
             std::vector<Value> items;
             bool all_num = true;
+            // A list comprehension, as OpenSCAD's: `[for (i = [0 : 9]) f(i)]` gives the
+            // iterations' values; an `if` without `else` that is false gives none, and a `for`
+            // (or an `if` choosing one) inside runs nested: `[for (i = ...) for (j = ...) i * j]`.
+            auto keep = [&](const ast::Expr& cond, Env* scope) {
+                const std::optional<bool> k = const_truth(eval(cond, scope), cond.loc);
+                if (!k) fail(cond.loc, "a list comprehension's condition must be a constant");
+                return *k;
+            };
+            std::function<void(const ast::Expr&, Env*)> generate = [&](const ast::Expr& x, Env* scope) {
+                if (x.kind == K::For) {
+                    run_for(x.bindings, scope, x.loc, [&](Env* body) {
+                        if (x.block) {
+                            Value v = eval_block(*x.block, body, false);
+                            if (v.t != VT::None) all_num &= v.t == VT::Number, items.push_back(std::move(v));
+                        } else {
+                            generate(*x.body, body);
+                        }
+                    });
+                    return;
+                }
+                const bool has_else = x.kind == K::If && x.elems.size() >= 3 && x.elems[2];
+                if (x.kind == K::If && (!has_else || x.elems[1]->kind == K::For || x.elems[2]->kind == K::For)) {
+                    if (keep(*x.elems[0], scope)) generate(*x.elems[1], scope);
+                    else if (has_else) generate(*x.elems[2], scope);
+                    return;
+                }
+                Value v = eval(x, scope);
+                if (v.t == VT::None) return;
+                all_num &= v.t == VT::Number;
+                items.push_back(std::move(v));
+            };
             for (const auto& el : e.elems) {
                 if (el->kind == K::For) {
-                    // A list comprehension, as OpenSCAD's: `[for (i = [0 : 9]) f(i)]` gives the
-                    // iterations' values (an `if` without `else` that is false gives none).
-                    run_for(el->bindings, env, el->loc, [&](Env* body) {
-                        const ast::Expr* b = el->block ? nullptr : el->body.get();
-                        if (b && b->kind == K::If && (b->elems.size() < 3 || !b->elems[2])) {  // a filter
-                            const std::optional<bool> keep = const_truth(eval(*b->elems[0], body), b->elems[0]->loc);
-                            if (!keep) fail(b->elems[0]->loc, "a list comprehension's condition must be a constant");
-                            if (!*keep) return;
-                            b = b->elems[1].get();
-                        }
-                        Value v = el->block ? eval_block(*el->block, body, false) : eval(*b, body);
-                        if (v.t == VT::None) return;
-                        all_num &= v.t == VT::Number;
-                        items.push_back(std::move(v));
-                    });
+                    generate(*el, env);
                     continue;
                 }
                 items.push_back(eval(*el, env));

@@ -45,13 +45,19 @@ TEST_CASE("a user modifier's errors name it", "[lang]") {
           "test.sdf:3:15: error: the target of at must be a shape, not a number");
 }
 
-TEST_CASE("list comprehensions give the iterations' values, an if without else none", "[lang]") {
+TEST_CASE("list comprehensions give the iterations' values, an if without else none, a for inside runs nested", "[lang]") {
     // [0, 1, 4, 9, 16]: the sphere's radius is 16 / 16.
     CHECK(dist_of("let l = [for (i = [0 : 4]) i * i]; sphere(l[4] / 16);", 0, 0, 0) == Approx(-1.0f));
     // Three numbers make a vector, as a literal's do.
     CHECK(dist_of("translate([for (i = [0 : 2]) i]) sphere(1);", 0, 1, 2) == Approx(-1.0f));
     // A filter: [0, 2, 4], the last is 4.
     CHECK(dist_of("let l = [for (i = [0 : 5]) if (i % 2 == 0) i]; sphere(l[2]);", 0, 0, 0) == Approx(-4.0f));
+    // Nested generators, as OpenSCAD's: [1, 2, 2, 4, 3, 6], then [[2, 0], [2, 1], [4, 0], [4, 1]]
+    // (an if choosing a for), then [-1, 2, 3].
+    CHECK(dist_of("let v = [for (i = [1 : 3]) for (j = [1 : 2]) i * j]; sphere(v[5]);", 0, 0, 0) == Approx(-6.0f));
+    CHECK(dist_of("let w = [for (i = [1 : 4]) if (i % 2 == 0) for (j = [0 : 1]) [i, j]]; sphere(w[3][0] + w[3][1] + w[1][1]);", 0, 0, 0) ==
+          Approx(-6.0f));
+    CHECK(dist_of("let u = [for (i = [1 : 3]) if (i > 1) i else -i]; sphere(u[1] + u[2] + u[0]);", 0, 0, 0) == Approx(-4.0f));
     // An outline for polygon: a square from its corners.
     CHECK(dist_of("extrude(2) polygon([for (a = [45 : 90 : 315]) [cos(radians(a)), sin(radians(a))] * sqrt(2)]);", 0, 0, 0) ==
           Approx(-1.0f).margin(1e-5));
