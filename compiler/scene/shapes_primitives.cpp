@@ -79,7 +79,9 @@ Bounds bounds_Box(const BoundsIn& b) { return sym(glm::abs(b.v3(BoxP::size)) * 0
 
 Lowered lower_RoundBox(L& l, const Shape& s, const Vec3N& p) {
     Vec3N b = P3(s, RoundBoxP::size), a = l.abs3(p);
-    NodeId r = P(s, RoundBoxP::r);
+    // A radius over half the smallest side would shrink the box: at most that (a sphere for
+    // a cube), so the full size is kept.
+    NodeId r = l.mn(P(s, RoundBoxP::r), l.mul(l.mn(l.mn(b[0], b[1]), b[2]), l.half));
     Vec3N q;
     for (int i = 0; i < 3; ++i) q[i] = l.add(l.sub(a[i], l.mul(b[i], l.half)), r);
     return exact(l.sub(l.box_q(q), r));
@@ -148,7 +150,8 @@ Lowered lower_Cylinder(L& l, const Shape& s, const Vec3N& p) {
 Bounds bounds_Cylinder(const BoundsIn& b) { return sym({b.f(CylinderP::r), b.f(CylinderP::h) * 0.5f, b.f(CylinderP::r)}); }
 
 Lowered lower_RoundCylinder(L& l, const Shape& s, const Vec3N& p) {
-    NodeId e = P(s, RoundCylinderP::edge);
+    // An edge over the radius or half the height would shrink the cylinder: at most those.
+    NodeId e = l.mn(P(s, RoundCylinderP::edge), l.mn(P(s, RoundCylinderP::r), l.mul(P(s, RoundCylinderP::h), l.half)));
     NodeId dx = l.add(l.sub(l.len2(p[0], p[2]), P(s, RoundCylinderP::r)), e);
     NodeId dy = l.add(l.sub(l.abs(p[1]), l.mul(P(s, RoundCylinderP::h), l.half)), e);
     return exact(l.sub(l.box2_q(dx, dy), e));

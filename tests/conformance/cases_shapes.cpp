@@ -44,6 +44,10 @@ void add_primitive_cases(std::vector<Case>& out) {
     // round_box keeps its full size and rounds the edges; the rounded corner's centre is at 0.75.
     s.script("round_box(2, 0.25);").at(2, 0, 0, 1).at(2, 2, 2, std::sqrt(3 * 1.25 * 1.25) - 0.25);
     s.script("round_box([1, 2, 3], 0.2);").random(ref3([](dv3 p) { return box_ref(p, dv3{0.5, 1, 1.5} - 0.2) - 0.2; }));
+    // A radius over half the smallest side is that half: the full size is kept (a cube
+    // becomes a sphere).
+    s.script("round_box(2, 1.5);").at(1, 0, 0, 0).at(2, 0, 0, 1).at(0, 0, 0, -1).at(2, 2, 2, std::sqrt(12.0) - 1);
+    s.script("round_box([1, 2, 3], 0.9);").random(ref3([](dv3 p) { return box_ref(p, dv3{0.5, 1, 1.5} - 0.5) - 0.5; }));
 
     // box_frame: distance to the edges only. The face centre of a frame is open: the nearest
     // edge is at distance half - e along the face.
@@ -84,6 +88,7 @@ void add_primitive_cases(std::vector<Case>& out) {
         return std::min(std::max(dx, dy), 0.0) + len2(std::max(dx, 0.0), std::max(dy, 0.0));
     }));
 
+    s.script("round_cylinder(2, 1, 2);").at(0, 2, 0, 1).at(2, 0, 0, 1).at(0, 0, 0, -1);  // edge at most r and h / 2
     s.script("round_cylinder(2, 1, 0.2);").at(0, 2, 0, 1).at(2, 0, 0, 1).random(ref3([](dv3 p) {
         double dx = len2(p.x, p.z) - 0.8, dy = std::fabs(p.y) - 0.8;
         return std::min(std::max(dx, dy), 0.0) + len2(std::max(dx, 0.0), std::max(dy, 0.0)) - 0.2;
