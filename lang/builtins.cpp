@@ -529,7 +529,7 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
             };
             r.width = whole(0, 1, 16384);
             r.height = whole(1, 1, 16384);
-            r.samples = whole(2, 1, 1024);
+            r.samples = whole(2, 1, 4096);  // (as --samples and the API)
             r.max_steps = whole(3, 1, 100000);
             r.max_distance = const_num(Value::number(b.size(4, true)), b.loc(4), "max_distance");
             r.max_distance_set = b.has(4);
