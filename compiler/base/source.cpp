@@ -33,6 +33,33 @@ std::string_view SourceFile::line(uint32_t n) const {
     return std::string_view(text).substr(b, e - b);
 }
 
+namespace {
+// The columns a terminal gives a code point: 2 for East Asian wide and full-width characters
+// and emoji, 0 for combining marks, zero-width spaces and variation selectors, else 1
+// (the caret of a line with CJK text or emoji then sits under its column).
+int display_width(uint32_t c) {
+    if ((c >= 0x0300 && c <= 0x036F) || (c >= 0x200B && c <= 0x200F) || (c >= 0xFE00 && c <= 0xFE0F) || c == 0x20E3) return 0;
+    const bool wide = (c >= 0x1100 && c <= 0x115F) || (c >= 0x2E80 && c <= 0x303E) || (c >= 0x3041 && c <= 0x33FF) ||
+                      (c >= 0x3400 && c <= 0x4DBF) || (c >= 0x4E00 && c <= 0x9FFF) || (c >= 0xA000 && c <= 0xA4CF) ||
+                      (c >= 0xAC00 && c <= 0xD7A3) || (c >= 0xF900 && c <= 0xFAFF) || (c >= 0xFE30 && c <= 0xFE4F) ||
+                      (c >= 0xFF00 && c <= 0xFF60) || (c >= 0xFFE0 && c <= 0xFFE6) || (c >= 0x1F300 && c <= 0x1F64F) ||
+                      (c >= 0x1F900 && c <= 0x1F9FF) || (c >= 0x20000 && c <= 0x3FFFD);
+    return wide ? 2 : 1;
+}
+
+// The code point starting at byte i of s (a lead byte), and how many bytes it takes.
+uint32_t decode_at(std::string_view s, size_t i, size_t& len) {
+    const auto u = [&](size_t k) { return static_cast<unsigned char>(s[k]); };
+    const unsigned char b = u(i);
+    len = b < 0x80 ? 1 : b >= 0xF0 ? 4 : b >= 0xE0 ? 3 : b >= 0xC0 ? 2 : 1;
+    for (size_t k = 1; k < len; ++k)
+        if (i + k >= s.size() || (u(i + k) & 0xC0) != 0x80) len = 1;  // (not well formed: a byte of its own)
+    uint32_t c = len == 1 ? b : len == 2 ? (b & 0x1Fu) : len == 3 ? (b & 0x0Fu) : (b & 0x07u);
+    for (size_t k = 1; k < len; ++k) c = (c << 6) | (u(i + k) & 0x3Fu);
+    return c;
+}
+}  // namespace
+
 std::string format_diagnostic(const Diagnostic& d, const char* kind) {
     if (!d.loc.known()) return fmt::format("sdfc: {}: {}\n", kind, d.message);
     const SourceFile& file = *d.loc.file;
@@ -71,10 +98,14 @@ std::string format_diagnostic(const Diagnostic& d, const char* kind) {
     out += src.substr(b, e - b);
     if (e < src.size()) out += "...";
     out += '\n';
-    // Keep tabs so the caret lines up in a terminal.
+    // Keep tabs so the caret lines up in a terminal; wide characters take two columns.
     out.append(lead.size(), ' ');
-    for (size_t i = b; i < col; ++i)
-        if (!continuation(i)) out += src[i] == '\t' ? '\t' : ' ';
+    for (size_t i = b; i < col;) {
+        size_t len = 1;
+        if (src[i] == '\t') out += '\t';
+        else if (!continuation(i)) out.append(size_t(display_width(decode_at(src, i, len))), ' ');
+        i += len;
+    }
     out += "^\n";
     return out;
 }

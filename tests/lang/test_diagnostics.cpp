@@ -28,11 +28,20 @@ TEST_CASE("unknown names suggest the nearest known one") {
           "test.sdf:1:8: error: render has no parameter 'widht' (did you mean `width`?)");
 }
 
-TEST_CASE("columns count characters, and an error at the end of the file points after the last token") {
+TEST_CASE("columns count characters, the caret counts wide ones twice, and an error at the end of the file points after the last token") {
     CHECK(error_of("let s = \"\u00fc\u00fc\u00fc\"; sphere(q);") ==
           "test.sdf:1:23: error: unknown name 'q'\n"
           "let s = \"\u00fc\u00fc\u00fc\"; sphere(q);\n"
           "                      ^\n");
+    // The caret under the column as a terminal shows it: wide characters (CJK, emoji) take two.
+    CHECK(error_of("let s = \"\u65e5\u672c\"; sphere(q);") ==
+          "test.sdf:1:22: error: unknown name 'q'\n"
+          "let s = \"\u65e5\u672c\"; sphere(q);\n"
+          "                       ^\n");
+    CHECK(error_of("let s = \"\U0001F389\"; sphere(q);") ==
+          "test.sdf:1:21: error: unknown name 'q'\n"
+          "let s = \"\U0001F389\"; sphere(q);\n"
+          "                     ^\n");
     CHECK(error_of("sphere(1);\nbox(\n") ==
           "test.sdf:2:5: error: expected ')'\n"
           "box(\n"
