@@ -399,8 +399,8 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
                 const Binding& h = have->second;
                 const bool same = h.loc.file == b.loc.file && h.loc.line == b.loc.line && h.loc.col == b.loc.col;
                 if (!same && h.loc.file == s.loc.file && h.value.t != VT::Function)
-                    fail(s.loc, fmt::format("this import defines '{}' ({}:{}), which is already defined in this scope (at line {})", name,
-                                            b.loc.file ? b.loc.file->path : std::string("?"), b.loc.line, h.loc.line));
+                    fail(s.loc, fmt::format("this import defines '{}' ({}:{}), which is already defined in this scope ({})", name,
+                                            b.loc.file ? b.loc.file->path : std::string("?"), b.loc.line, where_defined(h.loc, s.loc)));
             }
             return;
         }

@@ -65,6 +65,38 @@ SDFC_IV_INLINE bool zero_times_infinity(float al, float ah, float bl, float bh) 
     return (a0 & infinite_end(bl, bh)) | (b0 & infinite_end(al, ah));
 }
 
+// |v| over [l, h]: the least and the greatest.
+SDFC_IV_INLINE void abs_ends(float l, float h, float& lo, float& hi) {
+    lo = l >= 0.0f ? l : (h <= 0.0f ? -h : 0.0f);
+    hi = mx(-l, h);
+}
+
+// The length of (a, b) or, Three, (a, b, c): Length2's and Length3's interval.
+template <bool Three>
+SDFC_IV_INLINE void length_iv(float al, float ah, float bl, float bh, float cl, float ch, float& lo, float& hi) {
+    float a0, a1, b0, b1;
+    abs_ends(al, ah, a0, a1);
+    abs_ends(bl, bh, b0, b1);
+    float s0 = a0 * a0 + b0 * b0, s1 = a1 * a1 + b1 * b1;
+    if constexpr (Three) {
+        float c0, c1;
+        abs_ends(cl, ch, c0, c1);
+        s0 += c0 * c0;
+        s1 += c1 * c1;
+    }
+    lo = mx(dn(std::sqrt(s0)), 0.0f);
+    hi = up(std::sqrt(s1));
+}
+
+// [l, h] + k (AddI, and the fused length ops after their length): the VM's rounded add is
+// monotonic, so the ends' sums bound it; z turns NaN for inf - inf or a NaN k.
+SDFC_IV_INLINE void add_k_iv(float l, float h, float k, float& lo, float& hi, float& z) {
+    lo = l + k;
+    hi = h + k;
+    z += opposite_infinities(l, h, k, k) ? kNaN : 0.0f;
+    z += std::isnan(k) ? kNaN : 0.0f;
+}
+
 // Interval product (corners); no NaN for finite operands.
 SDFC_IV_INLINE void mul_iv(float al, float ah, float bl, float bh, float& lo, float& hi) {
     float p0 = al * bl, p1 = al * bh, p2 = ah * bl, p3 = ah * bh;
@@ -278,45 +310,17 @@ SDFC_IV_INLINE void iv(float al, float ah, float bl, float bh, float cl, float c
             hi = f ? 0.0f : 1.0f;
             break;
         }
-        case Op::Length2: {
-            float a0 = al >= 0.0f ? al : (ah <= 0.0f ? -ah : 0.0f), a1 = mx(-al, ah);
-            float b0 = bl >= 0.0f ? bl : (bh <= 0.0f ? -bh : 0.0f), b1 = mx(-bl, bh);
-            lo = dn(std::sqrt(a0 * a0 + b0 * b0));
-            hi = up(std::sqrt(a1 * a1 + b1 * b1));
-            lo = mx(lo, 0.0f);
-            break;
-        }
-        case Op::Length3: {
-            float a0 = al >= 0.0f ? al : (ah <= 0.0f ? -ah : 0.0f), a1 = mx(-al, ah);
-            float b0 = bl >= 0.0f ? bl : (bh <= 0.0f ? -bh : 0.0f), b1 = mx(-bl, bh);
-            float c0 = cl >= 0.0f ? cl : (ch <= 0.0f ? -ch : 0.0f), c1 = mx(-cl, ch);
-            lo = dn(std::sqrt(a0 * a0 + b0 * b0 + c0 * c0));
-            hi = up(std::sqrt(a1 * a1 + b1 * b1 + c1 * c1));
-            lo = mx(lo, 0.0f);
-            break;
-        }
+        case Op::Length2: length_iv<false>(al, ah, bl, bh, cl, ch, lo, hi); break;
+        case Op::Length3: length_iv<true>(al, ah, bl, bh, cl, ch, lo, hi); break;
         case Op::Length2I:
         case Op::Length3I: {
-            // Length2 / Length3's interval (a zero c for Length2), then AddI's: the rounding
-            // of the VM's add is monotonic, so the ends' sums bound it.
-            const bool three = O == Op::Length3I;
-            float a0 = al >= 0.0f ? al : (ah <= 0.0f ? -ah : 0.0f), a1 = mx(-al, ah);
-            float b0 = bl >= 0.0f ? bl : (bh <= 0.0f ? -bh : 0.0f), b1 = mx(-bl, bh);
-            float c0 = !three ? 0.0f : (cl >= 0.0f ? cl : (ch <= 0.0f ? -ch : 0.0f)), c1 = !three ? 0.0f : mx(-cl, ch);
-            float l0 = mx(dn(std::sqrt(a0 * a0 + b0 * b0 + c0 * c0)), 0.0f);
-            float l1 = up(std::sqrt(a1 * a1 + b1 * b1 + c1 * c1));
-            lo = l0 + k;
-            hi = l1 + k;
-            z += opposite_infinities(l0, l1, k, k) ? kNaN : 0.0f;
-            z += std::isnan(k) ? kNaN : 0.0f;
+            // Length2 / Length3's interval, then AddI's.
+            float l0, l1;
+            length_iv<O == Op::Length3I>(al, ah, bl, bh, cl, ch, l0, l1);
+            add_k_iv(l0, l1, k, lo, hi, z);
             break;
         }
-        case Op::AddI:
-            lo = al + k;
-            hi = ah + k;
-            z += opposite_infinities(al, ah, k, k) ? kNaN : 0.0f;
-            z += std::isnan(k) ? kNaN : 0.0f;
-            break;
+        case Op::AddI: add_k_iv(al, ah, k, lo, hi, z); break;
         case Op::SubI:
             lo = k - ah;
             hi = k - al;
