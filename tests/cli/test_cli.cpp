@@ -229,6 +229,21 @@ TEST_CASE("bench prints one line of times and evaluations, --baseline evaluates 
     CHECK(field(s4.out, "rays") > 3.0 * field(fast.out, "rays"));
 }
 
+TEST_CASE("bench's later renders take the tape tree the first kept, --fresh-tree builds one each render") {
+    const std::string scene = test::example("showcase.sdf");
+    auto kept = run_sdfc("bench '" + scene + "' --width 96 --height 54 --repeat 1 --warmup 1 --threads 2");
+    auto fresh = run_sdfc("bench '" + scene + "' --width 96 --height 54 --repeat 1 --warmup 1 --threads 2 --fresh-tree");
+    REQUIRE(kept.status == 0);
+    REQUIRE(fresh.status == 0);
+    INFO(kept.out << fresh.out);
+    CHECK(field(kept.out, "tree_leaves") > 0);
+    CHECK(field(kept.out, "tree_reused") == 1);
+    CHECK(field(fresh.out, "tree_reused") == 0);
+    // The same tree either way, and the same evaluations.
+    CHECK(field(fresh.out, "tree_leaves") == field(kept.out, "tree_leaves"));
+    CHECK(field(fresh.out, "evals_per_pixel") == field(kept.out, "evals_per_pixel"));
+}
+
 TEST_CASE("bench --warmup: untimed renders first, the first render's time apart as cold_ms") {
     const std::string scene = test::example("three-tori.sdf");
     auto none = run_sdfc("bench '" + scene + "' --width 32 --height 18 --repeat 1 --warmup 0");
