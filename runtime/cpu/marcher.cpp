@@ -99,6 +99,7 @@ void Worker::run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish
     size_t next = 0;
     const size_t count = rs.size();
     const bool tree = T_.active;
+    uint32_t hint = 0;  // the leaf of the ray loaded last
     for (;;) {
         while (n < kWindow && next < count) {
             const uint32_t r = static_cast<uint32_t>(next++);
@@ -108,6 +109,17 @@ void Worker::run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish
             }
             L.load(n, rs, r, f_.relax);
             init(L, n);
+            if (tree) {
+                // Its first leaf from the one before's: the rays come in pixel order, so their
+                // points are nearly always in that leaf or one nearby (a short walk from its
+                // neighbour instead of the whole way down from the root).
+                const float px = L.ox[n] + L.t[n] * L.dx[n], py = L.oy[n] + L.t[n] * L.dy[n], pz = L.oz[n] + L.t[n] * L.dz[n];
+                const TapeTree::Leaf& lf = T_.leaves[hint];
+                const bool in = px >= lf.lo[0] && px <= lf.hi[0] && py >= lf.lo[1] && py <= lf.hi[1] && pz >= lf.lo[2] &&
+                                pz <= lf.hi[2];
+                if (!in) hint = T_.locate_from(hint, px, py, pz);
+                L.set_leaf(n, hint, T_.leaves[hint]);
+            }
             ++n;
         }
         if (n == 0) return;
