@@ -539,6 +539,7 @@ int cmd_glsl(Args& a) {
     Args flags = flat_args(ov);
     apply_render_flags(s.render, flags);
     GlslOutput g = compile_glsl(s, t, go);
+    check_field_finite(s, g.distance, g.probes);
     if (g.tape && g.tape_texels > kNvidiaConstArrayTexels && !go.tape_texture &&
         (t == GlslTarget::Shadertoy || t == GlslTarget::Glsl330))
         std::fprintf(stderr,

@@ -103,13 +103,12 @@ Loc first_known(const Shape& s) {
 
 }  // namespace
 
-void check_field_finite(const Scene& s, const CompiledScene& cs) {
-    if (s.raw_field || !s.root || has_user_field(*s.root)) return;
-    Evaluator ev(cs.distance);
-    const glm::vec3 at[3] = {glm::vec3(0.0f), cs.camera.position, cs.camera.target};
+static void check_finite_at(const Scene& s, const Program& distance, const std::vector<glm::vec3>& at, float time) {
+    if (s.raw_field || !s.root || has_user_field(*s.root) || distance.outputs.empty()) return;
+    Evaluator ev(distance);
     float d0 = 0.0f;
-    for (int i = 0; i < 3; ++i) {
-        float d = ev.eval1(at[i].x, at[i].y, at[i].z, cs.time);
+    for (size_t i = 0; i < at.size(); ++i) {
+        float d = ev.eval1(at[i].x, at[i].y, at[i].z, time);
         if (!std::isnan(d) && d > -INFINITY) return;  // +inf is an empty scene: nothing anywhere
         if (i == 0) d0 = d;
     }
@@ -117,6 +116,14 @@ void check_field_finite(const Scene& s, const CompiledScene& cs) {
                        fmt::format("the scene's distance is not a number ({} at the origin and at the camera): "
                                    "a size or a scale overflows",
                                    d0));
+}
+
+void check_field_finite(const Scene& s, const CompiledScene& cs) {
+    check_finite_at(s, cs.distance, {glm::vec3(0.0f), cs.camera.position, cs.camera.target}, cs.time);
+}
+
+void check_field_finite(const Scene& s, const Program& distance, const std::vector<glm::vec3>& at) {
+    check_finite_at(s, distance, at, 0.0f);
 }
 
 }  // namespace sdfc::cli

@@ -30,5 +30,8 @@ void report_stdout_error(int err);
 // the camera or its target (`scale(1e38) sphere(1e38)`: -inf everywhere) is an error at the
 // scene's first shape. A user's `field` and a .vm model may compute what they like.
 void check_field_finite(const Scene& s, const CompiledScene& cs);
+// The same for a distance program and the points to try (sdfc glsl: the origin, and the
+// camera where it does not move), at time 0.
+void check_field_finite(const Scene& s, const Program& distance, const std::vector<glm::vec3>& at);
 
 }  // namespace sdfc::cli

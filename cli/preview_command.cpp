@@ -18,6 +18,7 @@
 #include <fmt/format.h>
 
 #include "cli/common.hpp"
+#include "cli/output_checks.hpp"
 #include "cli/file_watch.hpp"
 #include "cli/preview/server_api.hpp"
 #include "compiler/glsl/glsl.hpp"
@@ -48,6 +49,7 @@ Build build_shader(const std::string& path, const Common& c) {
         GlslOptions go;
         go.sample = sample_batch;
         GlslOutput out = compile_glsl(s, GlslTarget::HtmlShader, go);
+        check_field_finite(s, out.distance, out.probes);  // (as sdfc glsl and render)
         b.shader = std::move(out.text);
         b.scene = std::move(out.scene_json);
         if (!out.tape_words.empty()) b.tape = glsl::tape_base64(out.tape_words);

@@ -67,6 +67,8 @@ struct Parts {
     size_t instructions = 0;
     int samples = 1, max_steps = 256, max_bounces = 3;  // the knobs (knob_block)
     std::vector<SceneParam> params;                    // the script's params (sdf_param[i])
+    Program distance;                                  // (GlslOutput::distance)
+    std::vector<glm::vec3> probes;                     // (GlslOutput::probes)
 };
 
 Parts generate(const Scene& scene, const GlslOptions& options, glsl::TapeStorage storage) {
@@ -265,6 +267,10 @@ Parts generate(const Scene& scene, const GlslOptions& options, glsl::TapeStorage
     c += "\n// ---- scene settings: camera, lights, ambient, background ----\n";
     c += glsl::function(set, fs);
     c += glsl::kRendererBody;
+    out.probes.push_back(glm::vec3(0.0f));
+    if (in.camera_position) out.probes.push_back(*in.camera_position);
+    if (in.camera_target) out.probes.push_back(*in.camera_target);
+    out.distance = std::move(dist);
     return out;
 }
 
@@ -409,6 +415,8 @@ GlslOutput compile_glsl(const Scene& scene, GlslTarget target, const GlslOptions
     out.max_steps = p.max_steps;
     out.max_bounces = p.max_bounces;
     out.scene_json = scene_json(p);
+    out.distance = std::move(p.distance);
+    out.probes = std::move(p.probes);
     if (target == GlslTarget::HtmlShader || target == GlslTarget::Glsl330) out.tape_words = std::move(p.tape_words);
     return out;
 }

@@ -47,6 +47,8 @@ struct GlslOutput {
     size_t instructions = 0;           // of the distance and shading programs
     int samples = 1, max_steps = 256, max_bounces = 3;  // the knobs' values for the script (Html: their uniforms)
     std::string scene_json;            // what the html page reads besides the shader (time, knobs, parameters)
+    Program distance;                  // the distance the shader computes, as bytecode (its `time` reads the time given)
+    std::vector<glm::vec3> probes;     // the origin, and the camera's position and target where they are constant
 };
 
 // `scene` must be built with a symbolic time (InterpretOptions::time = nullopt) so `time`

@@ -70,6 +70,15 @@ TEST_CASE("a distance that overflowed to -infinity is refused at compile time") 
     CHECK(msg.find("error: the scene's distance is not a number (-inf at the origin and at the camera)") != std::string::npos);
     std::tie(st, msg) = check("bigok.sdf", "scale(1e10) sphere(1e10);\n");
     CHECK(st == 0);
+    // sdfc glsl refuses it too (its shader would draw nothing), as does every target.
+    std::string p = test::write_temp("overflow_glsl.sdf", "scale(1e38) sphere(1e38);\n");
+    for (const char* target : {"shadertoy", "glsl330", "html"}) {
+        auto r = run_sdfc("glsl " + q(p) + " --target " + target);
+        CHECK(r.status == 1);
+        CHECK(r.out.empty());
+        CHECK(r.err.find(p + ":1:1: error: the scene's distance is not a number (-inf at the origin and at the camera)") == 0);
+    }
+    CHECK(run_sdfc("glsl " + q(test::write_temp("bigok_glsl.sdf", "scale(1e10) sphere(1e10);\n"))).status == 0);
 }
 
 TEST_CASE("math messages: normalize of a tiny vector and pow of a negative number") {
