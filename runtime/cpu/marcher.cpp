@@ -114,10 +114,7 @@ void Worker::run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish
                 // points are nearly always in that leaf or one nearby (a short walk from its
                 // neighbour instead of the whole way down from the root).
                 const float px = L.ox[n] + L.t[n] * L.dx[n], py = L.oy[n] + L.t[n] * L.dy[n], pz = L.oz[n] + L.t[n] * L.dz[n];
-                const TapeTree::Leaf& lf = T_.leaves[hint];
-                const bool in = px >= lf.lo[0] && px <= lf.hi[0] && py >= lf.lo[1] && py <= lf.hi[1] && pz >= lf.lo[2] &&
-                                pz <= lf.hi[2];
-                if (!in) hint = T_.locate_from(hint, px, py, pz);
+                hint = T_.locate_from(hint, px, py, pz);
                 L.set_leaf(n, hint, T_.leaves[hint]);
             }
             ++n;

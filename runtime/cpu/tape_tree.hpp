@@ -57,6 +57,9 @@ struct TapeTree {
         const Guard* guards = nullptr;  // leaf 0: the program's (the VM skips far regions)
         // The tape for an evaluator sized to the tree's max_regs.
         TapeView view() const { return TapeView{code, len, &out, 1, 0, TapeView::kUncounted, guards}; }
+        bool holds(float x, float y, float z) const {
+            return x >= lo[0] && x <= hi[0] && y >= lo[1] && y <= hi[1] && z >= lo[2] && z <= hi[2];
+        }
     };
     static_assert(sizeof(Leaf) == 64);
     glm::vec3 lo{0}, hi{0};
@@ -126,9 +129,10 @@ struct TapeTree {
     // than kEmptyVisits nodes (a box over much fine detail: not worth proving).
     static constexpr int kEmptyVisits = 256;
     bool all_empty(const glm::vec3& blo, const glm::vec3& bhi) const;
-    // The same, starting from leaf `near` (through its rope).
+    // The same, starting from leaf `near` (itself, or through its rope).
     uint32_t locate_from(uint32_t near, float x, float y, float z) const {
         if (!active) return 0;
+        if (leaves[near].holds(x, y, z)) return near;
         const Leaf& L = leaves[near];
         return find_from(rope(near, face_beyond(L.lo, L.hi, x, y, z)), x, y, z);
     }

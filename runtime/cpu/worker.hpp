@@ -138,11 +138,7 @@ private:
         for (size_t i0 = 0; i0 < count; i0 += kWindow) {
             const int m = static_cast<int>(std::min<size_t>(kWindow, count - i0));
             for (int j = 0; j < m; ++j) {
-                const float px = x[i0 + j], py = y[i0 + j], pz = z[i0 + j];
-                const TapeTree::Leaf& lf = T_.leaves[prev];
-                const bool in = px >= lf.lo[0] && px <= lf.hi[0] && py >= lf.lo[1] && py <= lf.hi[1] && pz >= lf.lo[2] &&
-                                pz <= lf.hi[2];
-                if (!in) prev = T_.locate_from(prev, px, py, pz);
+                prev = T_.locate_from(prev, x[i0 + j], y[i0 + j], z[i0 + j]);
                 pleaf_[j] = prev;
             }
             eval_grouped(x + i0, y + i0, z + i0, pleaf_, m, out + i0);
