@@ -21,6 +21,7 @@
 #include "cli/common.hpp"
 #include "cli/options.hpp"
 #include "cli/output_checks.hpp"
+#include "cli/output_names.hpp"
 #include "compiler/bytecode/compile.hpp"
 #include "compiler/glsl/glsl.hpp"
 #include "compiler/glsl/glsl_tape.hpp"
@@ -51,35 +52,6 @@ std::string image_format_flag(const std::string& out, const std::optional<std::s
     }
     if (format) throw UsageError(fmt::format("--format is for -o - (standard output); the extension of '{}' names its format", out));
     return "";
-}
-
-// What `{name}` stands for: the scene file's name without its folder and extension,
-// "stdin" for a script read from standard input.
-std::string scene_name(const std::string& path) { return path == "-" ? "stdin" : std::filesystem::path(path).stem().string(); }
-
-// `{frame:04d}`, `{frame}` and `{name}` in an output path.
-std::string expand(std::string out, int frame, const std::string& name) {
-    auto replace = [&](const std::string& key, const std::string& val) {
-        for (size_t p; (p = out.find(key)) != std::string::npos;) out.replace(p, key.size(), val);
-    };
-    for (size_t p; (p = out.find("{frame:")) != std::string::npos;) {
-        size_t e = out.find('}', p);
-        if (e == std::string::npos) break;
-        std::string spec = out.substr(p + 7, e - p - 7);
-        int width = 0;
-        if (!spec.empty() && spec.back() == 'd') {
-            std::string digits = spec.substr(0, spec.size() - 1);
-            width = digits.empty() ? 0 : std::atoi(digits.c_str());
-            if (digits.size() > 2 || width < 0 || width > 32)
-                throw UsageError(fmt::format("unsupported frame format '{{frame:{}}}' (at most 32 digits)", spec));
-        } else {
-            throw UsageError(fmt::format("unsupported frame format '{{frame:{}}}' (use {{frame:04d}})", spec));
-        }
-        out.replace(p, e - p + 1, fmt::format("{:0{}d}", frame, width));
-    }
-    replace("{frame}", std::to_string(frame));
-    replace("{name}", name);
-    return out;
 }
 
 // The flags that override the script's camera and render(...) settings (render and bench).
@@ -235,6 +207,7 @@ int cmd_render(Args& a) {
         if (*view == "steps") ro.view = RenderView::Steps;
         else if (*view != "shaded") throw UsageError(fmt::format("--view takes shaded or steps, not '{}'", *view));
     }
+    if (*out != "-") (void)expand(*out, 0, "");  // (a malformed placeholder first)
     int f0 = 0, f1 = 0;
     float fps = 24.0f;
     bool animated = frames.has_value();
@@ -246,16 +219,21 @@ int cmd_render(Args& a) {
         if (f1 < f0) throw UsageError("--frames A:B needs A <= B");
         if (f1 - f0 + 1 > c.max_frames)
             throw UsageError(fmt::format("{} frames is over the limit of {} (raise it with --max-frames)", f1 - f0 + 1, c.max_frames));
-        if (out->find("{frame") == std::string::npos && f1 > f0)
+        if (f1 > f0 && *out == "-")
+            throw UsageError("standard output (-o -) takes one picture: give the frames a file name with {frame:04d}");
+        if (f1 > f0 && expand(*out, f0, "") == expand(*out, f0 + 1, ""))
             throw UsageError("rendering several frames needs {frame:04d} in the output name");
     }
     if (fps_s) {
         fps = Args::to_float("--fps", *fps_s);
         if (!(fps > 0)) throw UsageError("--fps must be positive");
     }
+    if (scenes.size() > 1 && *out == "-")
+        throw UsageError("standard output (-o -) takes one picture: give the scenes a file name with {name}");
     if (scenes.size() > 1 && out->find("{name}") == std::string::npos)
         throw UsageError("rendering several scenes needs {name} in the output name");
     const size_t items = scenes.size() * size_t(f1 - f0 + 1);
+    if (items > 1) check_distinct_outputs(*out, scenes, f0, f1);
     if (bands && items > 1) throw UsageError("--tiles renders one band of one picture: give one scene and one frame");
     const Shard shard = read_shard(shard_s, items);
     // Item k (the scenes' frames in order) is this task's when k % count == index.

@@ -62,7 +62,7 @@ std::vector<CommandSpec> make_commands() {
                  with({
                           {"--output", "-o", "OUT", "FILE", "",
                            "the picture; its extension names the format; may hold {frame:04d} (or {frame}) and {name} (the scene's "
-                           "file stem, stdin for -); - is standard output (needs --format)"},
+                           "file stem, stdin for -), {{ and }} for braces; - is standard output (needs --format)"},
                           {"--format", "", "F", kImageFormats, "", "the image format of standard output (-o -)"},
                           time,
                           {"--frames", "", "A:B", "", "", "frames A to B at --fps, time = --time + frame / fps"},

@@ -31,7 +31,7 @@ void report_stdout_error(int err);
 // scene's first shape. A user's `field` and a .vm model may compute what they like.
 void check_field_finite(const Scene& s, const CompiledScene& cs);
 // The same for a distance program and the points to try (sdfc glsl: the origin, and the
-// camera where it does not move), at time 0.
+// camera where it does not move), when the program does not depend on `time`.
 void check_field_finite(const Scene& s, const Program& distance, const std::vector<glm::vec3>& at);
 
 }  // namespace sdfc::cli

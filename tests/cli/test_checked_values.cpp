@@ -79,6 +79,8 @@ TEST_CASE("a distance that overflowed to -infinity is refused at compile time") 
         CHECK(r.err.find(p + ":1:1: error: the scene's distance is not a number (-inf at the origin and at the camera)") == 0);
     }
     CHECK(run_sdfc("glsl " + q(test::write_temp("bigok_glsl.sdf", "scale(1e10) sphere(1e10);\n"))).status == 0);
+    // A size that depends on time may overflow at time 0 only: the shader is written.
+    CHECK(run_sdfc("glsl " + q(test::write_temp("time_glsl.sdf", "sphere(1 / time);\n"))).status == 0);
 }
 
 TEST_CASE("math messages: normalize of a tiny vector and pow of a negative number") {

@@ -144,6 +144,48 @@ TEST_CASE("render --frames writes one file per frame, and they differ where the 
     CHECK(bad.err == "sdfc: error: rendering several frames needs {frame:04d} in the output name\n");
 }
 
+TEST_CASE("output names: a malformed or unknown placeholder, and two pictures to one file, are refused before any work") {
+    std::string s = test::write_temp("names.sdf", "render(width = 8, height = 8);\nsphere(1);\n");
+    fs::path dir = fs::path(test::temp_dir()) / "names";
+    fs::remove_all(dir);
+    fs::create_directories(dir / "d1");
+    fs::create_directories(dir / "d2");
+    auto render = [&](const std::string& scenes, const std::string& out, const std::string& more) {
+        return run_sdfc("render " + scenes + " -o '" + (dir / out).string() + "' --quiet " + more);
+    };
+    const std::string d = (dir / "").string();
+    auto r = render("'" + s + "'", "f{frame.png", "--frames 0:2");
+    CHECK(r.status == 2);
+    CHECK(r.err == "sdfc: error: the output name '" + d + "f{frame.png' has a '{' with no '}' (known: {frame:04d}, {frame}, {name})\n");
+    r = render("'" + s + "'", "f{frme}.png", "");
+    CHECK(r.status == 2);
+    CHECK(r.err == "sdfc: error: unknown '{frme}' in the output name '" + d +
+                       "f{frme}.png' (known: {frame:04d}, {frame}, {name}; write {{ and }} for braces)\n");
+    r = render("'" + s + "'", "f}.png", "");
+    CHECK(r.status == 2);
+    CHECK(r.err == "sdfc: error: the output name '" + d + "f}.png' has a '}' with no '{' (write }} for a brace)\n");
+    r = render("'" + s + "'", "f{frame:x4d}.png", "--frames 0:1");
+    CHECK(r.err == "sdfc: error: unsupported frame format '{frame:x4d}' (use {frame:04d})\n");
+    CHECK(fs::is_empty(dir / "d1"));
+    // Braces doubled are braces.
+    r = render("'" + s + "'", "b{{{frame}}}.png", "--frames 1:2");
+    CHECK(r.status == 0);
+    CHECK(fs::exists(dir / "b{1}.png"));
+    CHECK(fs::exists(dir / "b{2}.png"));
+    // Two scenes of one file name, or one scene twice: refused, nothing written.
+    const std::string a = test::write_temp("names_d1.sdf", "sphere(1);\n");
+    fs::copy_file(a, dir / "d1" / "x.sdf", fs::copy_options::overwrite_existing);
+    fs::copy_file(a, dir / "d2" / "x.sdf", fs::copy_options::overwrite_existing);
+    r = render("'" + (dir / "d1" / "x.sdf").string() + "' '" + (dir / "d2" / "x.sdf").string() + "'", "{name}.png", "");
+    CHECK(r.status == 2);
+    CHECK(r.err == "sdfc: error: '" + (dir / "d1" / "x.sdf").string() + "' and '" + (dir / "d2" / "x.sdf").string() +
+                       "' would both be written to '" + d + "x.png' ({name} is the file name without its folder and extension)\n");
+    CHECK(!fs::exists(dir / "x.png"));
+    r = run_sdfc("render '" + s + "' -o - --format png --frames 0:1");
+    CHECK(r.status == 2);
+    CHECK(r.err == "sdfc: error: standard output (-o -) takes one picture: give the frames a file name with {frame:04d}\n");
+}
+
 TEST_CASE("an animation whose script fails at a later frame writes no frame and names it") {
     std::string s = test::write_temp("anim_fail.sdf", "render(width = 16, height = 12);\nsphere(1 - time);\n");
     fs::path dir = fs::path(test::temp_dir()) / "anim_fail";
