@@ -659,7 +659,9 @@ int main(int argc, char** argv) {
     };
     if (!sdfc::run_on_new_stack(stack, work)) work();
     errno = 0;
-    if (std::fclose(stdout) != 0) {
+    // (EBADF: standard output was closed, and nothing went to it, or the flush above would
+    // have failed: not an error, as for GNU tools)
+    if (std::fclose(stdout) != 0 && errno != EBADF) {
         sdfc::cli::report_stdout_error(errno);
         return 1;
     }

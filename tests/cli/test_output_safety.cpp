@@ -216,6 +216,16 @@ TEST_CASE("standard output that cannot be written is an error") {
         CHECK(r.status == 1);
         CHECK(r.err.find("sdfc: error: cannot write to standard output: ") == 0);
     }
+    // A closed standard output that nothing is written to is no error (as for GNU tools).
+    const std::string png = test::temp_dir() + "/closed_stdout.png";
+    for (const std::string& args : {"check " + q(s), "render " + q(s) + " -o " + q(png) + " --width 8 --height 8",
+                                    "glsl " + q(s) + " -o " + q(test::temp_dir() + "/closed_stdout.glsl")}) {
+        INFO(args);
+        auto r = run_to(args, "&-");
+        CHECK(r.status == 0);
+        CHECK(r.err.find("error") == std::string::npos);
+    }
+    CHECK(fs::exists(png));
 }
 
 TEST_CASE("an output that is the script or a file it imports is refused") {
