@@ -13,6 +13,17 @@ namespace sdfc {
 Value Interp::call_math(const BuiltinInfo& info, std::vector<Value>& args, const std::vector<Loc>& locs, Loc loc) {
     Graph& gr = *g;
     using B = Builtin;
+    if (info.id == B::Len) {  // (of any value with elements, not only numbers)
+        if (args.size() != 1) fail(loc, fmt::format("len takes 1 argument, not {}", args.size()));
+        const Value& a = args[0];
+        size_t n = 0;
+        if (a.t == VT::Vector) n = a.n;
+        else if (a.t == VT::List) n = a.list->size();
+        else if (a.t == VT::Range) n = size_t(a.range.count());
+        else if (a.t == VT::String) n = size_t(std::count_if(a.str->begin(), a.str->end(), [](char c) { return (c & 0xC0) != 0x80; }));
+        else fail(locs[0], fmt::format("len takes a list, a vector, a range or a string, not {}", describe(a)));
+        return Value::number(gr.constant(float(n)));
+    }
     auto arity = [&](size_t lo, size_t hi) {
         if (args.size() < lo || args.size() > hi) {
             if (lo == hi) fail(loc, fmt::format("{} takes {} argument{}, not {}", info.name, lo, lo == 1 ? "" : "s", args.size()));

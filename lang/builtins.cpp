@@ -9,7 +9,6 @@
 #include <fmt/format.h>
 
 #include "compiler/scene/lower.hpp"
-#include "lang/css_colors.hpp"
 #include "lang/interp.hpp"
 
 namespace sdfc {
@@ -174,6 +173,9 @@ struct Binder {
                 if (out.values[idx]) in.fail(a.loc, fmt::format("argument '{}' of {} is given twice", a.name, info.name));
             }
             Value v = in.eval(*a.value, env);
+            // A colour parameter takes a name too: material(color = "tomato"), light(color = "white").
+            if (v.t == VT::String && std::string_view(info.params[idx].name) == "color" && info.params[idx].type != PT::Any)
+                v = in.colour_name(*v.str, a.value->loc);
             check_type(info.params[idx], v, a.value->loc);
             out.values[idx] = std::make_unique<Value>(std::move(v));
             out.locs[idx] = a.value->loc;
@@ -416,19 +418,8 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
             if (b.has(0)) {
                 const Value& c = b.val(0);
                 if (c.t == VT::String) {
-                    // A CSS name or #rrggbb: sRGB, made linear like every colour of a scene.
-                    const auto rgb = css_color(*c.str);
-                    if (!rgb) {
-                        std::vector<std::string> names;
-                        for (const CssColor& k : kCssColors) names.push_back(k.name);
-                        const std::string near = nearest_name(*c.str, names);
-                        fail(b.loc(0), near.empty() ? fmt::format("unknown colour \"{}\" (a CSS name such as \"tomato\", or \"#rrggbb\")", *c.str)
-                                                    : fmt::format("unknown colour \"{}\" (did you mean \"{}\"?)", *c.str, near));
-                    }
-                    for (int k = 0; k < 3; ++k) {
-                        const float v = float((*rgb >> (16 - 8 * k)) & 0xFF) / 255.0f;
-                        mat[kMatR + k] = gr.constant(v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f));
-                    }
+                    const Value rgb = colour_name(*c.str, b.loc(0));
+                    for (int k = 0; k < 3; ++k) mat[kMatR + k] = rgb.c[k];
                 } else {
                     if (c.t != VT::Vector || c.n < 3)
                         fail(b.loc(0), fmt::format("color takes [r, g, b] or a colour name such as \"tomato\", not {}", describe(c)));

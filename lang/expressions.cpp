@@ -472,6 +472,9 @@ Value Interp::componentwise2(const Value& a, const Value& b, Loc loc, const std:
 
 Value Interp::unary(ast::UnOp op, const Value& a, Loc loc) {
     if (op == ast::UnOp::Not) {
+        if (a.t == VT::Shape)
+            fail(loc, "! of a shape: OpenSCAD's debug modifiers # % * ! have no use here (delete it, or comment the "
+                      "statement out)");
         return Value::boolean(g->unary(Op::Not, truth(a, loc)));
     }
     if (a.t != VT::Number && a.t != VT::Vector) fail(loc, fmt::format("cannot negate {}", describe(a)));

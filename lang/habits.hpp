@@ -26,6 +26,18 @@ inline std::string habit_hint(std::string_view name) {
         {"intersection_for", "write `intersection { for (i = [0 : 2]) ... }`"},
         {"union_for", "a `for` in a block unions its shapes: `union { for (i = [0 : 2]) ... }`"},
         {"echo", "sdfc has no echo: `sdfc eval SCENE --at X,Y,Z` prints distances"},
+        {"include", "sdfc reads another file with `import \"file.sdf\";` (its defs and lets)"},
+        {"use", "sdfc reads another file with `import \"file.sdf\";` (its defs and lets)"},
+        {"each", "sdfc has no each: a list comprehension's `for` adds one element per item, `[for (x = list) x]`"},
+        {"hull", "sdfc has no hull(): for two spheres, capsule(a, b, r) or cone(h, r1, r2); smooth_union(k) with a large k "
+                 "approximates others"},
+        {"minkowski", "minkowski() with a sphere is sdfc's `round(r) shape`: the shape grown by r, its edges rounded"},
+        {"offset", "offset(r) of a profile is sdfc's `round(r) profile`; round(-r) shrinks it"},
+        {"linear_extrude", "sdfc's is `extrude(h) profile`, centred on z = 0 (OpenSCAD's starts at z = 0)"},
+        {"rotate_extrude", "sdfc's is `revolve(offset) profile`, about the y axis"},
+        {"str", "sdfc has no string functions: strings name colours and settings"},
+        {"assert", "sdfc has no assert: a shape's arguments are checked where they are given"},
+        {"undef", "sdfc has no undef: give a default value"},
     };
     for (const Habit& h : kHabits)
         if (h.name == name) return " (" + std::string(h.hint) + ")";

@@ -129,6 +129,8 @@ public:
     Value call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>& args, Env* env, Loc loc);
     ShapePtr apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc);
     Value call_math(const BuiltinInfo& info, std::vector<Value>& args, const std::vector<Loc>& locs, Loc loc);
+    // A colour name (CSS, or #rrggbb) as linear RGB (lang/colours.cpp); an error at loc if unknown.
+    Value colour_name(const std::string& name, Loc loc);
 
     // --- helpers
     [[noreturn]] void fail(Loc loc, std::string msg);

@@ -495,7 +495,7 @@ void Interp::run_for(const std::vector<ast::ForBinding>& bindings, Env* env, Loc
         };
         if (it.t == VT::Range) {
             const RangeVal& r = it.range;
-            double n = std::max(0.0, std::floor((double(r.end) - r.start) / r.step + 1e-6) + 1);
+            const double n = r.count();
             if (n > double(opts.limits.max_loop_iterations))
                 fail(b.iterable->loc, fmt::format("this range has {} elements, over the loop limit of {} (raise it with --max-iterations)",
                                                   n, opts.limits.max_loop_iterations));

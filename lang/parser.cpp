@@ -178,6 +178,38 @@ bool is_keyword(std::string_view w) {
     return std::find(std::begin(kws), std::end(kws), w) != std::end(kws);
 }
 
+// Whether only blanks come before `off` on its line.
+bool line_start(std::string_view t, size_t off) {
+    while (off > 0 && (t[off - 1] == ' ' || t[off - 1] == '\t')) --off;
+    return off == 0 || t[off - 1] == '\n';
+}
+
+constexpr const char* kDebugModifiers =
+    " (OpenSCAD's debug modifiers # % * ! have no use here: delete it, or comment the statement out)";
+
+// A hint for OpenSCAD's syntax near a syntax error at `off`: a line that starts with
+// `include <` or `use <`, `each`, a debug modifier at a statement's start, a hex number.
+std::string openscad_hint(std::string_view t, size_t off, std::string_view msg) {
+    size_t start = off < t.size() ? off : previous_token_end(t, off);  // (the error may be at the end of the file)
+    while (start > 0 && t[start - 1] != '\n') --start;
+    while (start < t.size() && (t[start] == ' ' || t[start] == '\t')) ++start;
+    const std::string_view first = word_at(t, start);
+    size_t after = start + first.size();
+    while (after < t.size() && t[after] == ' ') ++after;
+    if ((first == "include" || first == "use") && after < t.size() && t[after] == '<') return habit_hint(first);
+    size_t w = previous_token_end(t, off);  // the word before the error
+    size_t b = w;
+    while (b > 0 && (std::isalnum(static_cast<unsigned char>(t[b - 1])) || t[b - 1] == '_')) --b;
+    for (size_t e = t.substr(0, off).find("each", start); e != std::string_view::npos && e < off; e = t.substr(0, off).find("each", e + 1))
+        if ((e == 0 || !(std::isalnum(static_cast<unsigned char>(t[e - 1])) || t[e - 1] == '_')) && e + 4 < t.size() && t[e + 4] == ' ')
+            return habit_hint("each");
+    if (off < t.size() && (t[off] == 'x' || t[off] == 'X') && w > 0 && t[w - 1] == '0' && b + 1 == w)
+        return " (sdfc has no hex numbers: write the number in decimal)";
+    if (start < t.size() && start == off && (t[off] == '*' || t[off] == '%' || t[off] == '!') && msg == "expected a statement")
+        return kDebugModifiers;
+    return "";
+}
+
 // Turns PEGTL's error into the diagnostic a user should read.
 CompileError syntax_error(const SourceFile& f, size_t off, std::string msg) {
     const std::string_view t = f.text;
@@ -200,6 +232,7 @@ CompileError syntax_error(const SourceFile& f, size_t off, std::string msg) {
             std::string hint = lone_amp ? fmt::format(" (did you mean '{0}{0}'?)", static_cast<char>(c))
                                : c == '\'' ? " (strings are written in double quotes)"
                                : c == '$'  ? " (OpenSCAD's $fn, $fa and $fs have no use here: sdfc's surfaces are exact)"
+                               : c == '#' && line_start(t, off) ? std::string(kDebugModifiers)
                                            : "";
             return CompileError(loc_at(f, off), fmt::format("unexpected character {}{}", what, hint));
         }
@@ -219,7 +252,10 @@ CompileError syntax_error(const SourceFile& f, size_t off, std::string msg) {
     if (msg.rfind("expected a ", 0) == 0 && msg.find("name") != std::string::npos && off < t.size()) {
         const std::string_view word = word_at(t, off);
         if (is_keyword(word)) msg += fmt::format(" ('{}' is a keyword)", word);
+        else if (t[off] == '(' && msg == "expected a name after 'let'")
+            msg += " (sdfc's let is a statement, `let x = 2;`, whose name holds for the rest of its block)";
     }
+    msg += openscad_hint(t, off, msg);
     return CompileError(loc_at(f, off), std::move(msg));
 }
 

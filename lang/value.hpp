@@ -1,7 +1,9 @@
 // Script values. Numbers, bools and vectors hold IR nodes (constants fold at once);
 // everything else is a shared, immutable payload.
 #pragma once
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -39,6 +41,8 @@ struct ModifierVal {
 
 struct RangeVal {
     float start = 0, step = 1, end = 0;
+    // The elements [start : step : end] holds (what `for` iterates).
+    double count() const { return std::max(0.0, std::floor((double(end) - start) / step + 1e-6) + 1); }
 };
 
 struct Value {

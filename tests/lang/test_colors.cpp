@@ -68,3 +68,18 @@ TEST_CASE("a colour field gives each point its colour, in local coordinates, ble
     // material(color = field ...) too, its other channels as given.
     CHECK(colour_of("material(color = field (p) -> [p.x, 0, 0], specular = 0.2) sphere(1);", 0.5f, 0, 0).r == Approx(0.5f));
 }
+
+TEST_CASE("every colour parameter takes a colour name: material, light, ambient, background", "[lang]") {
+    const glm::vec3 tomato(linear(255), linear(99), linear(71));
+    const glm::vec3 m = colour_of("material(color = \"tomato\", specular = 0) sphere(1);");
+    CHECK(m.r == Approx(tomato.r));
+    CHECK(m.b == Approx(tomato.b));
+    auto c = compile_text("light(position = [1, 2, 3], color = \"#ff6347\");\nambient(\"white\");\nbackground(\"black\");\nsphere(1);");
+    REQUIRE(c->cs.lights.size() == 1);
+    CHECK(c->cs.lights[0].color.g == Approx(tomato.g));
+    CHECK(c->cs.ambient == glm::vec3(1.0f));
+    CHECK(c->cs.background == glm::vec3(0.0f));
+    CHECK(first_error_line("light(color = \"tomatoe\");\nsphere(1);") ==
+          "test.sdf:1:15: error: unknown colour \"tomatoe\" (did you mean \"tomato\"?)");
+    CHECK(first_error_line("color(\"to\\\"mato\") sphere(1);") == "test.sdf:1:7: error: unknown colour \"to\\\"mato\" (did you mean \"tomato\"?)");
+}

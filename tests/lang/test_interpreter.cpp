@@ -45,6 +45,15 @@ TEST_CASE("for unions its iterations, nested bindings, vectors") {
     CHECK(close(dist_of("for (p = [[1, 0, 0], [0, 5, 0]]) translate(p) sphere(0.5);", 0, 5, 0), -0.5));
 }
 
+TEST_CASE("len counts a list's, a vector's, a range's elements and a string's characters") {
+    CHECK(close(dist_of("let pts = [[0, 0], [1, 0], [0.5, 1], [0, 2]]; sphere(len(pts));", 0, 0, 0), -4));
+    CHECK(close(dist_of("sphere(len([1, 2, 3]));", 0, 0, 0), -3));
+    CHECK(close(dist_of("sphere(len([0 : 2 : 9]));", 0, 0, 0), -5));  // 0, 2, 4, 6, 8
+    CHECK(close(dist_of("sphere(len(\"h\u00e9llo\"));", 0, 0, 0), -5));
+    CHECK(close(dist_of("let p = [[0, 0], [2, 0], [1, 2]]; for (i = [0 : len(p) - 1]) translate([p[i][0], p[i][1], 0]) sphere(0.5);",
+                        1, 2, 0), -0.5));
+}
+
 TEST_CASE("if/else at statement level and ?: in expressions") {
     CHECK(close(dist_of("let r = 0.5; if (r > 0.3) sphere(r); else box(r);", 0, 0, 1), 0.5));
     CHECK(close(dist_of("let r = 0.2; if (r > 0.3) sphere(r); else box(r);", 0, 0, 1), 0.9));
