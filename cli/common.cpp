@@ -82,8 +82,14 @@ void free_kept_scene() {
 }
 }  // namespace
 
-void print_warnings(const Scene& s) {
+void print_warnings(const Scene& s) { print_warnings(s, nullptr); }
+
+void print_warnings(const Scene& s, const CompileError* besides) {
     for (const Diagnostic& w : s.warnings) {
+        if (besides && std::any_of(besides->diagnostics().begin(), besides->diagnostics().end(), [&](const Diagnostic& d) {
+                return d.loc.file == w.loc.file && d.loc.line == w.loc.line && d.loc.col == w.loc.col;
+            }))
+            continue;
         const std::string text = format_diagnostic(w, "warning");
         if (g_warned.insert(text).second) std::fwrite(text.data(), 1, text.size(), stderr);
     }
@@ -96,8 +102,7 @@ CompiledScene build(SourceManager& sm, const std::string& path, Common& c, std::
     o.time = time;
     free_kept_scene();
     Scene s = load_scene(sm, path, o);
-    print_warnings(s);
-    CompiledScene cs = compile_scene(s);
+    CompiledScene cs = compile_then_warn(s, [&] { return compile_scene(s); });
     check_field_finite(s, cs);
     if (c.keep_scene) keep_until_next_build(std::move(s));
     return cs;

@@ -29,6 +29,22 @@ Common read_common(Args& a);
 std::string one_scene(Args& a, const char* cmd);
 // The script's warnings (path:line:col: warning: ...) on standard error.
 void print_warnings(const Scene& s);
+void print_warnings(const Scene& s, const CompileError* besides);
+// The scene's warnings once `compile` (what comes after loading) has run; when it throws a
+// CompileError, without those at one of its errors' places (a field's body runs there, so a
+// warning that a name in it "has not run" would be wrong).
+template <class F>
+auto compile_then_warn(const Scene& s, F&& compile) {
+    try {
+        auto r = compile();
+        print_warnings(s);
+        return r;
+    } catch (const CompileError& e) {
+        print_warnings(s, &e);
+        throw;
+    }
+}
+
 // Warnings already printed are printed again (sdfc watch: a new run).
 void forget_warnings();
 // Loads and compiles a scene at `time`, its distance checked finite.

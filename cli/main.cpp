@@ -382,8 +382,7 @@ int cmd_compile(Args& a) {
     }
     if (*emit == "ir") {
         Scene s = load_scene(sm, path, c.interp);
-        print_warnings(s);
-        LoweredScene ls = lower_scene(*s.graph, s);
+        LoweredScene ls = compile_then_warn(s, [&] { return lower_scene(*s.graph, s); });
         std::vector<NodeId> roots{ls.distance, ls.shading_distance};
         std::vector<std::string> names{"distance", "shading.d"};
         for (int i = 0; i < kMatChannels; ++i) {
@@ -511,12 +510,11 @@ int cmd_glsl(Args& a) {
     InterpretOptions o = c.interp;
     o.time = std::nullopt;  // `time` becomes iTime
     Scene s = load_scene(sm, path, o);
-    print_warnings(s);
     if (out) check_not_input(*out, sm);
     if (tape_file) check_not_input(*tape_file, sm);
     Args flags = flat_args(ov);
     apply_render_flags(s.render, flags);
-    GlslOutput g = compile_glsl(s, t, go);
+    GlslOutput g = compile_then_warn(s, [&] { return compile_glsl(s, t, go); });
     check_field_finite(s, g.distance, g.probes);
     if (g.tape && g.tape_texels > kNvidiaConstArrayTexels && !go.tape_texture &&
         (t == GlslTarget::Shadertoy || t == GlslTarget::Glsl330))

@@ -45,10 +45,9 @@ Build build_shader(const std::string& path, const Common& c) {
         InterpretOptions o = c.interp;
         o.time = std::nullopt;  // `time` becomes iTime
         Scene s = load_scene(sm, path, o);
-        print_warnings(s);
         GlslOptions go;
         go.sample = sample_batch;
-        GlslOutput out = compile_glsl(s, GlslTarget::HtmlShader, go);
+        GlslOutput out = compile_then_warn(s, [&] { return compile_glsl(s, GlslTarget::HtmlShader, go); });
         check_field_finite(s, out.distance, out.probes);  // (as sdfc glsl and render)
         b.shader = std::move(out.text);
         b.scene = std::move(out.scene_json);

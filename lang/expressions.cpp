@@ -51,7 +51,7 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                 v.fn = builtin_callable(bi->id);
                 return v;
             }
-            if (failed_lets.count(e.text)) throw CompileError(std::vector<Diagnostic>{});  // its error is out already
+            if (failed_lets.count(e.text) || failed_import) throw CompileError(std::vector<Diagnostic>{});  // its error is out already
             std::vector<std::string> names;
             if (habit_hint(e.text).empty())  // (else the names are not needed)
                 for (Env* s = env; s; s = s->parent)

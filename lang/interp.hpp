@@ -151,9 +151,11 @@ public:
 
     // -D: the main script's top-level env, which defines were used, and the override.
     Env* main_env = nullptr;
-    // Top-level lets whose value failed (reported once): a use of one is skipped quietly, not
-    // reported again as an unknown name.
+    // Names whose top-level let, var, assignment or def failed (reported once), and whether an
+    // import did: a use of such a name (after a failed import, of any unknown name) is skipped
+    // quietly, not reported again as an unknown name.
     std::set<std::string> failed_lets;
+    bool failed_import = false;
     std::vector<bool> define_used;
     Value defined_value(size_t k, const ast::Stmt& let, Env* env);
     void check_defines_used(Env* top);

@@ -167,6 +167,7 @@ Scene Interp::run(const SourceFile& file) {
                 exec(*st, top, shapes);
             } catch (const CompileError& e) {
                 errors.insert(errors.end(), e.diagnostics().begin(), e.diagnostics().end());
+                if (!top->vars.count(st->name)) failed_lets.insert(st->name);
             }
         }
     for (const auto& st : m.stmts) {
@@ -175,8 +176,9 @@ Scene Interp::run(const SourceFile& file) {
             exec(*st, top, shapes);
         } catch (const CompileError& e) {
             errors.insert(errors.end(), e.diagnostics().begin(), e.diagnostics().end());
-            if ((st->kind == ast::StmtKind::Let || st->kind == ast::StmtKind::Var) && !top->vars.count(st->name))
-                failed_lets.insert(st->name);
+            const bool names = st->kind == ast::StmtKind::Let || st->kind == ast::StmtKind::Var || st->kind == ast::StmtKind::Assign;
+            if (names && !top->vars.count(st->name)) failed_lets.insert(st->name);
+            failed_import |= st->kind == ast::StmtKind::Import;
             if (errors.size() >= 20) break;
         }
     }

@@ -23,6 +23,7 @@ public:
             case ast::StmtKind::Let:
             case ast::StmtKind::Var:
             case ast::StmtKind::Def:
+            case ast::StmtKind::Assign:  // (one to an undeclared name is an error of its own when it runs)
                 bound.insert(s->name);
                 break;
             default:

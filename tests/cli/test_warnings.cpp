@@ -29,6 +29,12 @@ TEST_CASE("a name bound nowhere, in code that has not run, is a warning with the
     // Every name of a valid script is bound somewhere: no warning.
     CHECK(run_sdfc("check " + q(test::example("showcase.sdf"))).err.empty());
     (void)lib;
+    // A field's body runs when the scene compiles: its unknown name is the error, not also a
+    // warning that it has not run.
+    const std::string f = test::write_temp("warn_field.sdf", "field (p) -> lenght(p) - 1;\n");
+    r = run_sdfc("check " + q(f));
+    CHECK(r.status == 1);
+    CHECK(r.err == f + ":1:14: error: unknown name 'lenght' (did you mean `length`?)\nfield (p) -> lenght(p) - 1;\n             ^\n");
 }
 
 TEST_CASE("warnings for one-operand CSG, an empty difference and an ignored alpha") {

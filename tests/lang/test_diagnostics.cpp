@@ -115,6 +115,16 @@ TEST_CASE("a let whose value failed is reported once, not again at each use") {
     CHECK(e.find("'b'") == std::string::npos);
 }
 
+TEST_CASE("a def or an assignment that failed is reported once, not again as an unknown name at its uses") {
+    CHECK(error_of("def f(a, a) = a;\nsphere(f(1, 2));\n") ==
+          "test.sdf:1:10: error: parameter 'a' is named twice in 'f'\n"
+          "def f(a, a) = a;\n"
+          "         ^\n");
+    const std::string e = error_of("x = 2;\nsphere(x);\n");
+    CHECK(e.find("test.sdf:1:1: error: unknown variable 'x'") == 0);
+    CHECK(e.find("unknown name 'x'") == std::string::npos);
+}
+
 TEST_CASE("var is for field blocks, let cannot be reassigned") {
     CHECK(first_error_line("var x = 1;") == "test.sdf:1:1: error: 'var' is only allowed inside a field block; use 'let' for a constant");
     CHECK(first_error_line("field (p) -> { let d = 1; d = 2; d };") ==

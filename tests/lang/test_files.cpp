@@ -126,6 +126,12 @@ TEST_CASE("import cycles are errors at the import that closes them") {
     d.write("y/d.sdf", "import \"e.sdf\";\n");
     d.write("y/e.sdf", "\n\nimport \"../x/c.sdf\";\n");
     CHECK(d.first_error("x/c.sdf") == "DIR/y/e.sdf:3:1: error: import cycle: c.sdf -> d.sdf -> e.sdf -> c.sdf");
+    // The names the failed import would have brought are not reported again as unknown.
+    d.write("p.sdf", "import \"q.sdf\";\ndef fp() = 1;\nsphere(fq());\n");
+    d.write("q.sdf", "import \"p.sdf\";\ndef fq() = 1;\n");
+    const std::string e = d.errors("p.sdf");
+    CHECK(e.find("DIR/q.sdf:1:1: error: import cycle: p.sdf -> q.sdf -> p.sdf") == 0);
+    CHECK(e.find("unknown name") == std::string::npos);
 }
 
 TEST_CASE("missing, directory, FIFO and oversized files are located errors") {
