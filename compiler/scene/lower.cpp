@@ -95,32 +95,66 @@ Bounds shape_bounds(const Graph& g, const Shape& s) {
     return infinite();
 }
 
-bool clip_regions(const Graph& g, const Shape& s, Bounds& box, std::vector<glm::vec4>& half_spaces) {
+namespace {
+
+// clip_regions of a shape placed by a rigid motion: world = r * local + t.
+bool clip_placed(const Graph& g, const Shape& s, const glm::mat3& r, const glm::vec3& t, Bounds& box,
+                 std::vector<glm::vec4>& half_spaces) {
     check_stack(s.loc);
+    auto constant = [&] {
+        for (NodeId n : s.params)
+            if (!g.is_const(n)) return false;
+        return true;
+    };
     switch (s.kind) {
         case ShapeKind::Union:
             for (const auto& c : s.children)
-                if (!clip_regions(g, *c, box, half_spaces)) return false;
+                if (!clip_placed(g, *c, r, t, box, half_spaces)) return false;
             return true;
-        case ShapeKind::Material: return s.children.empty() || clip_regions(g, *s.children[0], box, half_spaces);
+        case ShapeKind::Material: return s.children.empty() || clip_placed(g, *s.children[0], r, t, box, half_spaces);
+        case ShapeKind::Translate: {  // (a floor is often placed so: translate([0, -1, 0]) plane())
+            if (!constant() || s.children.empty()) break;
+            const Vec3N v = P3(s, TranslateP::v);
+            const glm::vec3 d(g.const_value(v[0]), g.const_value(v[1]), g.const_value(v[2]));
+            return clip_placed(g, *s.children[0], r, t + r * d, box, half_spaces);
+        }
+        case ShapeKind::Rotate: {
+            if (!constant() || s.children.empty()) break;
+            glm::mat3 m(1.0f);  // world = m * local (bounds_Rotate)
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) m[j][i] = g.const_value(s.params.at(RotateP::m + size_t(i) * 3 + size_t(j)));
+            return clip_placed(g, *s.children[0], r * m, t, box, half_spaces);
+        }
         case ShapeKind::Plane: {
-            for (NodeId n : s.params)
-                if (!g.is_const(n)) return false;
+            if (!constant()) return false;
             const Vec3N pn = P3(s, PlaneP::normal);
             const glm::vec3 n(g.const_value(pn[0]), g.const_value(pn[1]), g.const_value(pn[2]));
             const float len = glm::length(n), h = g.const_value(P(s, PlaneP::offset));
             if (!(len > 0.0f) || !std::isfinite(len) || !std::isfinite(h)) return false;
-            half_spaces.emplace_back(n / len, h);
+            // n.q <= h for q = r^T (p - t): (r n).p <= h + (r n).t
+            const glm::vec3 wn = r * (n / len);
+            const float w = h + glm::dot(wn, t);
+            if (!std::isfinite(w)) return false;
+            half_spaces.emplace_back(wn, w);
             return true;
         }
-        default: {
-            const Bounds b = shape_bounds(g, s);
-            if (is_empty(b)) return true;
-            if (!b.finite()) return false;
-            box = join(box, b);
-            return true;
-        }
+        default: break;
     }
+    const Bounds b = shape_bounds(g, s);
+    if (is_empty(b)) return true;
+    if (!b.finite()) return false;
+    for (int i = 0; i < 8; ++i) {
+        const glm::vec3 c{i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z};
+        const glm::vec3 q = r * c + t;
+        box = join(box, Bounds{q, q});
+    }
+    return true;
+}
+
+}  // namespace
+
+bool clip_regions(const Graph& g, const Shape& s, Bounds& box, std::vector<glm::vec4>& half_spaces) {
+    return clip_placed(g, s, glm::mat3(1.0f), glm::vec3(0.0f), box, half_spaces);
 }
 
 }  // namespace sdfc

@@ -23,7 +23,8 @@ Lowered lower_shape(Graph& g, const Shape& shape, const Vec3N& p, const Material
 Bounds shape_bounds(const Graph& g, const Shape& shape);
 
 // Where a surface can be, for clipping rays in scenes with a floor: the planes of the
-// top-level unions (through material modifiers) as half-spaces n.p <= w (unit n), and a
+// top-level unions (through material modifiers, and translations and rotations by
+// constants) as half-spaces n.p <= w (unit n), and a
 // box around everything else (`box` is joined to; it stays empty if there is nothing
 // else). False when something else is unbounded or a plane's parameters are not constants.
 bool clip_regions(const Graph& g, const Shape& shape, Bounds& box, std::vector<glm::vec4>& half_spaces);

@@ -60,3 +60,27 @@ TEST_CASE("auto box: unbounded scenes have none", "[mesh]") {
     CHECK_FALSE(box_of("repeat([2, 2, 2]) sphere(0.5);").found);
     CHECK_FALSE(box_of("field (p) -> 1;").found);  // no surface anywhere
 }
+
+TEST_CASE("auto box: a floor moved or turned by constants is a floor too", "[mesh]") {
+    // The box of the rest, as for plane(offset = -0.6): translate and rotate place the plane.
+    const Box plain = box_of("sphere(1); plane([0, 1, 0], -0.6);");
+    REQUIRE(plain.found);
+    for (const char* src : {"sphere(1); translate([0, -0.6, 0]) plane();", "sphere(1); translate([5, -0.6, 2]) material(color = [1, 0, 0]) plane();",
+                            "sphere(1); rotate(x = 20) translate([0, -2, 0]) plane();"}) {
+        INFO(src);
+        const Box b = box_of(src);
+        REQUIRE(b.found);
+        CHECK(glm::all(glm::lessThanEqual(b.lo, glm::vec3(-1.0f))));
+        CHECK(glm::all(glm::greaterThanEqual(b.hi, glm::vec3(1.0f))));
+    }
+    auto c = compile_text("sphere(1); rotate(x = 20) translate([0, -2, 0]) plane();");
+    REQUIRE(c->cs.half_spaces.size() == 1);
+    const glm::vec4 h = c->cs.half_spaces[0];  // the plane's normal turned by 20 degrees about x
+    CHECK(h.x == Approx(0.0f).margin(1e-6));
+    CHECK(h.y == Approx(std::cos(glm::radians(20.0f))));
+    CHECK(h.z == Approx(std::sin(glm::radians(20.0f))));
+    CHECK(h.w == Approx(-2.0f));
+    auto m = compile_text("sphere(1); translate([0, -0.6, 0]) plane();");
+    REQUIRE(m->cs.half_spaces.size() == 1);
+    CHECK(m->cs.half_spaces[0].w == Approx(-0.6f));
+}
