@@ -69,7 +69,7 @@ std::vector<CommandSpec> make_commands() {
                           {"--fps", "", "F", "", "24", "frames per second of --frames"},
                           {"--aov", "", "LIST", "depth normal steps", "",
                            "extra planes, comma-separated: depth, normal, steps; in EXR the channels Z (misses: +inf), N.x "
-                           "N.y N.z, steps.Y; else side files OUT.NAME.png (OUT.NAME.exr beside hdr or pfm)"},
+                           "N.y N.z, steps.Y; else side files OUT.NAME.png (OUT.NAME.exr beside hdr)"},
                           {"--view", "", "shaded|steps", "shaded steps", "shaded", "steps: a heat map of the steps each ray took"},
                           {"--alpha", "", "on|off", "on off", "on for exr, else off",
                            "coverage as an alpha channel (exr, png, tif, tga); EXR colour is then premultiplied, 8-bit "
