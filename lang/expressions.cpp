@@ -129,6 +129,13 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                 if (v.range.step == 0.0f || !std::isfinite(v.range.step)) fail(e.elems[1]->loc, "a range's step must not be zero");
             }
             if (!std::isfinite(v.range.start) || !std::isfinite(v.range.end)) fail(e.loc, "a range's ends must be finite");
+            // Written so, [10 : 0] is likely meant as OpenSCAD takes it (the ends swapped); a
+            // computed one, [0 : len(list) - 1], is rightly empty.
+            if (!e.elems[1] && v.range.start > v.range.end && e.elems[0]->kind == K::Number && e.elems[2]->kind == K::Number)
+                scene.warnings.push_back({e.loc, fmt::format("the range [{} : {}] is empty (its start is above its end): for a "
+                                                             "count down write [{} : -1 : {}]",
+                                                             shown_number(v.range.start), shown_number(v.range.end),
+                                                             shown_number(v.range.start), shown_number(v.range.end))});
             return v;
         }
         case K::Unary:
