@@ -82,7 +82,8 @@ std::vector<std::string> Args::positionals() {
         if (used_[i]) continue;
         const std::string& a = args_[i];
         if (i < end_ && a.size() > 1 && a[0] == '-' && !std::isdigit(static_cast<unsigned char>(a[1])) && a[1] != '.') {
-            const std::string near = nearest_name(a.substr(0, a.find('=')), known_);
+            // (no guess for a one-letter option: any other one is as near)
+            const std::string near = a.size() <= 2 ? std::string() : nearest_name(a.substr(0, a.find('=')), known_);
             throw UsageError(near.empty() ? fmt::format("unknown option '{}' (see --help)", a)
                                           : fmt::format("unknown option '{}' (did you mean `{}`?)", a, near));
         }

@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "cli/output_checks.hpp"
+#include "lang/ast.hpp"
 #include "lang/load.hpp"
 #include "runtime/eval/vm.hpp"
 
@@ -34,7 +35,7 @@ Common read_common(Args& a) {
     if (auto v = a.value("--max-shape-depth")) l.max_shape_depth = Args::to_int("--max-shape-depth", *v, 1, 10000);
     if (auto v = a.value("--max-ops")) l.max_ops = size_t(Args::to_int("--max-ops", *v, 1, 2000000000));
     if (auto v = a.value("--max-file-size")) l.max_file_bytes = size_t(Args::to_int("--max-file-size", *v, 1, 2000000000));
-    if (auto v = a.value("--max-nesting")) l.max_nesting = Args::to_int("--max-nesting", *v, 1, 10000);
+    if (auto v = a.value("--max-nesting")) l.max_nesting = Args::to_int("--max-nesting", *v, 1, sdfc::ast::ParseOptions::kMostNesting);
     if (auto v = a.value("--max-pixels")) c.max_pixels = Args::to_int("--max-pixels", *v, 1, 2000000000);
     if (auto v = a.value("--max-frames")) c.max_frames = Args::to_int("--max-frames", *v, 1, 100000000);
     // -D name=value (OpenSCAD's flag): the script's top-level `let name` takes the value.

@@ -591,6 +591,7 @@ int dispatch(const std::vector<std::string>& all) {
     if (cmd == "merge") return cmd_merge(a);
     std::vector<std::string> cmds;
     for (const CommandSpec& c : commands()) cmds.push_back(c.name);
+    if (cmd.rfind("--", 0) == 0) cmds = {"--help", "--version"};  // (the options before a command)
     std::string near = nearest_name(cmd, cmds);
     throw UsageError(near.empty() ? fmt::format("unknown command '{}' (see sdfc --help)", cmd)
                                   : fmt::format("unknown command '{}' (did you mean `{}`?)", cmd, near));

@@ -128,6 +128,7 @@ struct Module {
 // grammar rule that failed, e.g. "expected ')'").
 struct ParseOptions {
     int max_nesting = 256;  // parentheses, brackets, blocks and modifier chains together
+    static constexpr int kMostNesting = 10000;  // the most --max-nesting takes
 };
 std::unique_ptr<Module> parse(const SourceFile& file, const ParseOptions& opts = {});
 

@@ -114,7 +114,9 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             for (const Value& it : items) v.depth = std::max(v.depth, it.depth + 1);
             // Lists built by a loop (`l = [l];`) nest without nesting the syntax.
             if (v.depth > uint32_t(opts.limits.max_nesting))
-                fail(e.loc, fmt::format("lists nested deeper than {} levels (raise it with --max-nesting)", opts.limits.max_nesting));
+                fail(e.loc, fmt::format("lists nested deeper than {} levels ({})", opts.limits.max_nesting,
+                                        opts.limits.max_nesting >= ast::ParseOptions::kMostNesting ? "the most --max-nesting allows"
+                                                                                                   : "raise it with --max-nesting"));
             v.list = std::make_shared<const std::vector<Value>>(std::move(items));
             return v;
         }

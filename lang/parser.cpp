@@ -93,7 +93,9 @@ struct base_control : pegtl::normal<Rule> {
         } guard{nullptr};
         if constexpr (nests) {
             if (st.depth >= st.max_depth)
-                throw CompileError(st.loc_at(in.current()), fmt::format("nesting deeper than {} levels (raise it with --max-nesting)", st.max_depth));
+                throw CompileError(st.loc_at(in.current()), fmt::format("nesting deeper than {} levels ({})", st.max_depth,
+                                               st.max_depth >= unsigned(ParseOptions::kMostNesting) ? "the most --max-nesting allows"
+                                                                                                   : "raise it with --max-nesting"));
             // Whatever max_depth was raised to, stop before the C++ stack runs out.
             if (stack_nearly_exhausted()) {
                 if (st.retry_on_low_stack) throw StackTooSmall{};

@@ -126,7 +126,7 @@ TEST_CASE("100,000 nested parentheses, blocks, minus signs, calls or modifiers s
         fits = c.fits_tsan;
 #endif
         if (fits) {
-            CHECK(raised == std::pair<int, std::string>{1, path + ":" + c.where_raised + ": error: nesting deeper than 10000 levels (raise it with --max-nesting)"});
+            CHECK(raised == std::pair<int, std::string>{1, path + ":" + c.where_raised + ": error: nesting deeper than 10000 levels (the most --max-nesting allows)"});
         } else {
             // Sanitizer builds cap the parser's stack (see parse() in lang/parser.cpp): the
             // stack guard stops these first, at a column that depends on the compiler.
