@@ -37,7 +37,7 @@ TEST_CASE("a name bound nowhere, in code that has not run, is a warning with the
     CHECK(r.err == f + ":1:14: error: unknown name 'lenght' (did you mean `length`?)\nfield (p) -> lenght(p) - 1;\n             ^\n");
 }
 
-TEST_CASE("a range written with its start above its end is empty and a warning; a computed one is quietly empty") {
+TEST_CASE("a range written with its start above its end is empty and a warning, a computed one is quietly empty") {
     const std::string s = test::write_temp("warn_range.sdf",
                                            "for (i = [10 : 0]) translate([i, 0, 0]) sphere(1);\n"
                                            "let n = 0;\nfor (i = [1 : n]) sphere(i);\nsphere(1);\n");
