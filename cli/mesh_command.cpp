@@ -118,7 +118,7 @@ int cmd_mesh(Args& a) {
         mo.lo = {f[0], f[1], f[2]}, mo.hi = {f[3], f[4], f[5]};
         if (!(mo.lo.x < mo.hi.x && mo.lo.y < mo.hi.y && mo.lo.z < mo.hi.z))
             throw UsageError("--bounds needs X0 < X1, Y0 < Y1 and Z0 < Z1");
-    } else if (!mesh::default_box(cs, mo.lo, mo.hi, t)) {
+    } else if (!mesh::default_box(cs, mo.lo, mo.hi, t, 8192, mo.resolution)) {
         const auto& code = cs.distance.code;
         const bool reads_point = std::any_of(code.begin(), code.end(), [](const Instr& in) {
             return in.op == Op::VarX || in.op == Op::VarY || in.op == Op::VarZ;

@@ -174,7 +174,8 @@ struct Binder {
             }
             Value v = in.eval(*a.value, env);
             // A colour parameter takes a name too: material(color = "tomato"), light(color = "white").
-            if (v.t == VT::String && std::string_view(info.params[idx].name) == "color" && info.params[idx].type != PT::Any)
+            const std::string_view pname = info.params[idx].name;
+            if (v.t == VT::String && (pname == "color" || pname == "emission") && info.params[idx].type != PT::Any)
                 v = in.colour_name(*v.str, a.value->loc);
             check_type(info.params[idx], v, a.value->loc);
             out.values[idx] = std::make_unique<Value>(std::move(v));

@@ -133,11 +133,17 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             if (!std::isfinite(v.range.start) || !std::isfinite(v.range.end)) fail(e.loc, "a range's ends must be finite");
             // Written so, [10 : 0] is likely meant as OpenSCAD takes it (the ends swapped); a
             // computed one, [0 : len(list) - 1], is rightly empty.
-            if (!e.elems[1] && v.range.start > v.range.end && e.elems[0]->kind == K::Number && e.elems[2]->kind == K::Number)
-                scene.warnings.push_back({e.loc, fmt::format("the range [{} : {}] is empty (its start is above its end): for a "
-                                                             "count down write [{} : -1 : {}]",
-                                                             shown_number(v.range.start), shown_number(v.range.end),
-                                                             shown_number(v.range.start), shown_number(v.range.end))});
+            auto literal = [&](const ast::Expr* x) {
+                return x && (x->kind == K::Number || (x->kind == K::Unary && x->un_op == ast::UnOp::Neg && x->lhs->kind == K::Number));
+            };
+            if (literal(e.elems[0].get()) && literal(e.elems[2].get()) && (!e.elems[1] || literal(e.elems[1].get())) &&
+                v.range.count() == 0) {
+                const std::string a = shown_number(v.range.start), z = shown_number(v.range.end);
+                scene.warnings.push_back({e.loc, e.elems[1] ? fmt::format("the range [{} : {} : {}] is empty (its step goes away from "
+                                                                          "its end)", a, shown_number(v.range.step), z)
+                                                            : fmt::format("the range [{} : {}] is empty (its start is above its end): "
+                                                                          "for a count down write [{} : -1 : {}]", a, z, a, z)});
+            }
             return v;
         }
         case K::Unary:

@@ -180,10 +180,16 @@ bool is_keyword(std::string_view w) {
     return std::find(std::begin(kws), std::end(kws), w) != std::end(kws);
 }
 
-// Whether only blanks come before `off` on its line.
-bool line_start(std::string_view t, size_t off) {
-    while (off > 0 && (t[off - 1] == ' ' || t[off - 1] == '\t')) --off;
-    return off == 0 || t[off - 1] == '\n';
+// Whether `off` starts a statement: only blanks and comments between it and the file's
+// start, a ';', a '{' or a '}'.
+bool statement_start(std::string_view t, size_t off) {
+    off = previous_token_end(t, off);  // (past blanks and comments)
+    return off == 0 || t[off - 1] == ';' || t[off - 1] == '{' || t[off - 1] == '}';
+}
+// ... or where a modifier's target starts (after its ')').
+bool target_start(std::string_view t, size_t off) {
+    const size_t p = previous_token_end(t, off);
+    return statement_start(t, off) || (p > 0 && t[p - 1] == ')');
 }
 
 constexpr const char* kDebugModifiers =
@@ -191,7 +197,7 @@ constexpr const char* kDebugModifiers =
 
 // A hint for OpenSCAD's syntax near a syntax error at `off`: a line that starts with
 // `include <` or `use <`, `each`, a debug modifier at a statement's start, a hex number.
-std::string openscad_hint(std::string_view t, size_t off, std::string_view msg) {
+std::string openscad_hint(std::string_view t, size_t off) {
     size_t start = off < t.size() ? off : previous_token_end(t, off);  // (the error may be at the end of the file)
     while (start > 0 && t[start - 1] != '\n') --start;
     while (start < t.size() && (t[start] == ' ' || t[start] == '\t')) ++start;
@@ -207,8 +213,17 @@ std::string openscad_hint(std::string_view t, size_t off, std::string_view msg) 
             return habit_hint("each");
     if (off < t.size() && (t[off] == 'x' || t[off] == 'X') && w > 0 && t[w - 1] == '0' && b + 1 == w)
         return " (sdfc has no hex numbers: write the number in decimal)";
-    if (start < t.size() && start == off && (t[off] == '*' || t[off] == '%' || t[off] == '!') && msg == "expected a statement")
-        return kDebugModifiers;
+    const bool stray_close = off + 1 < t.size() && t[off] == '*' && t[off + 1] == '/';  // (a comment's end)
+    if (off < t.size() && (t[off] == '*' || t[off] == '%') && !stray_close && target_start(t, off)) return kDebugModifiers;
+    // let (a = 2) ...: OpenSCAD's let expression, on the line before the error
+    const std::string_view upto = t.substr(0, std::min(t.size(), off + 3));  // (a let at the error itself too)
+    for (size_t e = upto.find("let", start); e != std::string_view::npos && e <= off; e = upto.find("let", e + 1)) {
+        size_t k = e + 3;
+        while (k < t.size() && t[k] == ' ') ++k;
+        if ((e == 0 || !(std::isalnum(static_cast<unsigned char>(t[e - 1])) || t[e - 1] == '_')) && k < t.size() && t[k] == '(')
+            return " (sdfc's let is a statement, `let x = 2;`, whose name holds for the rest of its block; in a def, "
+                   "`def f(x) = { let y = x * 2; y + 1 };`)";
+    }
     return "";
 }
 
@@ -233,8 +248,9 @@ CompileError syntax_error(const SourceFile& f, size_t off, std::string msg) {
             }
             std::string hint = lone_amp ? fmt::format(" (did you mean '{0}{0}'?)", static_cast<char>(c))
                                : c == '\'' ? " (strings are written in double quotes)"
+                               : c == '$' && t.substr(off, 2) == "$t" && !(off + 2 < t.size() && (std::isalnum(static_cast<unsigned char>(t[off + 2])) || t[off + 2] == '_')) ? " (OpenSCAD's $t is sdfc's `time`, in seconds: render --frames A:B --fps N)"
                                : c == '$'  ? " (OpenSCAD's $fn, $fa and $fs have no use here: sdfc's surfaces are exact)"
-                               : c == '#' && line_start(t, off) ? std::string(kDebugModifiers)
+                               : c == '#' && target_start(t, off) ? std::string(kDebugModifiers)
                                            : "";
             return CompileError(loc_at(f, off), fmt::format("unexpected character {}{}", what, hint));
         }
@@ -248,16 +264,15 @@ CompileError syntax_error(const SourceFile& f, size_t off, std::string msg) {
         while (start < off && (t[start] == ' ' || t[start] == '\t')) ++start;
         const std::string_view first = word_at(t, start);
         const size_t e = start + first.size();
-        const std::string hint = e < t.size() && t[e] == ' ' ? habit_hint(first) : "";
+        std::string hint = e < t.size() && t[e] == ' ' ? habit_hint(first) : "";
+        if (hint.empty()) hint = openscad_hint(t, off);
         return CompileError(loc_at(f, previous_token_end(t, off)), std::string(msg) + hint);
     }
     if (msg.rfind("expected a ", 0) == 0 && msg.find("name") != std::string::npos && off < t.size()) {
         const std::string_view word = word_at(t, off);
         if (is_keyword(word)) msg += fmt::format(" ('{}' is a keyword)", word);
-        else if (t[off] == '(' && msg == "expected a name after 'let'")
-            msg += " (sdfc's let is a statement, `let x = 2;`, whose name holds for the rest of its block)";
     }
-    msg += openscad_hint(t, off, msg);
+    msg += openscad_hint(t, off);
     return CompileError(loc_at(f, off), std::move(msg));
 }
 

@@ -190,7 +190,7 @@ Mesh Scene::mesh(const MeshSettings& m) const {
     if (given) {
         mo.lo = {m.bounds[0], m.bounds[1], m.bounds[2]}, mo.hi = {m.bounds[3], m.bounds[4], m.bounds[5]};
         if (!(mo.lo.x < mo.hi.x && mo.lo.y < mo.hi.y && mo.lo.z < mo.hi.z)) throw Error("mesh: the bounds need lo < hi on every axis");
-    } else if (!mesh::default_box(s.compiled, mo.lo, mo.hi, mo.time)) {
+    } else if (!mesh::default_box(s.compiled, mo.lo, mo.hi, mo.time, 8192, mo.resolution)) {
         throw Error("mesh: the scene is unbounded (a plane, an infinite repetition?): give MeshSettings::bounds");
     }
     const mesh::Mesh got = mesh::mesh_scene(s.compiled, mo);

@@ -104,7 +104,7 @@ bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3
     return true;
 }
 
-bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float time, size_t search_cells) {
+bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float time, size_t search_cells, int resolution) {
     if (scene.raw_field) {
         lo = glm::vec3(-1.0f), hi = glm::vec3(1.0f);
         return true;
@@ -118,7 +118,12 @@ bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float
         if (!interval_box(p, true, time, blo, bhi, search_cells)) return false;
     }
     const glm::vec3 ext = bhi - blo;
-    const float m = 0.02f * std::max({ext.x, ext.y, ext.z, 1e-3f});
+    const float longest = std::max({ext.x, ext.y, ext.z, 1e-3f});
+    float m = 0.02f * longest;
+    // (a floor at the rest's bounds is cut into a base m thick: one cell or less of it could
+    // fall between the samples, leaving no base)
+    if (!scene.bounds.finite() && !scene.half_spaces.empty() && resolution > 0)
+        m = std::max(m, 2.0f * longest / float(std::max(resolution - 4, 1)));
     lo = blo - m, hi = bhi + m;
     return true;
 }

@@ -75,7 +75,10 @@ Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* sta
 // shapes give no bounds (a custom field), the intervals find them (auto_box.cpp). False
 // when the scene is unbounded (an infinite repetition, only a plane): --bounds is needed.
 // `search_cells` caps the interval search's frontier (its cost; the fuzz target keeps it small).
-bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float time = 0.0f, size_t search_cells = 8192);
+// `resolution` (cells along the longest side, 0: unknown): with floors, the margin is at least
+// two cells, so the base is thick enough to be sampled.
+bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float time = 0.0f, size_t search_cells = 8192,
+                 int resolution = 0);
 
 // A box holding every point the interval evaluator does not prove outside, searched within
 // [-kSearch, kSearch]^3 to about 1/32 of the solid's size; false if that reaches the search

@@ -40,11 +40,14 @@ TEST_CASE("a name bound nowhere, in code that has not run, is a warning with the
 TEST_CASE("a range written with its start above its end is empty and a warning, a computed one is quietly empty") {
     const std::string s = test::write_temp("warn_range.sdf",
                                            "for (i = [10 : 0]) translate([i, 0, 0]) sphere(1);\n"
-                                           "let n = 0;\nfor (i = [1 : n]) sphere(i);\nsphere(1);\n");
+                                           "let n = 0;\nfor (i = [1 : n]) sphere(i);\nsphere(1);\n"
+                                           "for (i = [0 : -1 : 10]) sphere(i);\n");
     auto r = run_sdfc("check " + q(s));
     CHECK(r.status == 0);
     CHECK(r.err == s + ":1:10: warning: the range [10 : 0] is empty (its start is above its end): for a count down write "
-                       "[10 : -1 : 0]\nfor (i = [10 : 0]) translate([i, 0, 0]) sphere(1);\n         ^\n");
+                       "[10 : -1 : 0]\nfor (i = [10 : 0]) translate([i, 0, 0]) sphere(1);\n         ^\n" +
+                       s + ":5:10: warning: the range [0 : -1 : 10] is empty (its step goes away from its end)\n"
+                           "for (i = [0 : -1 : 10]) sphere(i);\n         ^\n");
 }
 
 TEST_CASE("warnings for one-operand CSG, an empty difference and an ignored alpha") {

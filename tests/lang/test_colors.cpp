@@ -71,7 +71,7 @@ TEST_CASE("a colour field gives each point its colour, in local coordinates, ble
 
 TEST_CASE("every colour parameter takes a colour name: material, light, ambient, background", "[lang]") {
     const glm::vec3 tomato(linear(255), linear(99), linear(71));
-    const glm::vec3 m = colour_of("material(color = \"tomato\", specular = 0) sphere(1);");
+    const glm::vec3 m = colour_of("material(color = \"tomato\", specular = 0, emission = \"black\") sphere(1);");
     CHECK(m.r == Approx(tomato.r));
     CHECK(m.b == Approx(tomato.b));
     auto c = compile_text("light(position = [1, 2, 3], color = \"#ff6347\");\nambient(\"white\");\nbackground(\"black\");\nsphere(1);");

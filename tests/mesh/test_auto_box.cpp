@@ -84,3 +84,20 @@ TEST_CASE("auto box: a floor moved or turned by constants is a floor too", "[mes
     REQUIRE(m->cs.half_spaces.size() == 1);
     CHECK(m->cs.half_spaces[0].w == Approx(-0.6f));
 }
+
+TEST_CASE("auto box: a floor at the rest's bounds is a base at a coarse resolution too", "[mesh]") {
+    // The base is the margin below the sphere: at 32 cells, 2 % of the box is under a cell.
+    auto c = compile_text("sphere(1); translate([0, -1, 0]) plane();");
+    for (int res : {16, 32, 48}) {
+        INFO("resolution " << res);
+        mesh::MeshOptions o;
+        o.resolution = res;
+        REQUIRE(mesh::default_box(c->cs, o.lo, o.hi, 0.0f, 8192, res));
+        const mesh::Mesh m = mesh::mesh_scene(c->cs, o);
+        float x0 = INFINITY, x1 = -INFINITY;
+        for (const glm::vec3& p : m.positions) x0 = std::min(x0, p.x), x1 = std::max(x1, p.x);
+        CHECK(x0 == Approx(o.lo.x));  // the base reaches the box's sides
+        CHECK(x1 == Approx(o.hi.x));
+        CHECK(bad_edges(m) == 0);
+    }
+}
