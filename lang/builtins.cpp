@@ -426,8 +426,8 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
                         fail(b.loc(0), fmt::format("color takes [r, g, b] or a colour name such as \"tomato\", not {}", describe(c)));
                     for (int k = 0; k < 3; ++k) mat[kMatR + k] = c.c[k];
                     if (c.n == 4)
-                        scene.warnings.push_back({b.loc(0), "color's alpha (the 4th component) is ignored: for see-through, "
-                                                            "material(transparency = ...)"});
+                        warn(b.loc(0), "color's alpha (the 4th component) is ignored: for see-through, "
+                                                            "material(transparency = ...)");
                 }
             } else {
                 // `color` with no argument only makes sense applied; use the default.
@@ -589,11 +589,11 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
         const bool meet = op.find("intersection") != std::string_view::npos;
         const bool empty = s.children.size() == 1 && (s.children[0]->kind == ShapeKind::Empty || (s.children[0]->kind == ShapeKind::Union && s.children[0]->children.empty()));
         if ((cut || meet) && empty)
-            scene.warnings.push_back({m.loc, fmt::format("this {} has no operands: it is empty", m.name)});
+            warn(m.loc, fmt::format("this {} has no operands: it is empty", m.name));
         else if (cut && s.children.size() == 1)
-            scene.warnings.push_back({m.loc, fmt::format("this {} has one operand: it cuts nothing away (a second shape is missing?)", m.name)});
+            warn(m.loc, fmt::format("this {} has one operand: it cuts nothing away (a second shape is missing?)", m.name));
         else if (meet && s.children.size() == 1)
-            scene.warnings.push_back({m.loc, fmt::format("this {} has one operand: it is that shape (a second shape is missing?)", m.name)});
+            warn(m.loc, fmt::format("this {} has one operand: it is that shape (a second shape is missing?)", m.name));
     };
     switch (m.id) {
         case B::Rotate: {

@@ -139,10 +139,10 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             if (literal(e.elems[0].get()) && literal(e.elems[2].get()) && (!e.elems[1] || literal(e.elems[1].get())) &&
                 v.range.count() == 0) {
                 const std::string a = shown_number(v.range.start), z = shown_number(v.range.end);
-                scene.warnings.push_back({e.loc, e.elems[1] ? fmt::format("the range [{} : {} : {}] is empty (its step goes away from "
+                warn(e.loc, e.elems[1] ? fmt::format("the range [{} : {} : {}] is empty (its step goes away from "
                                                                           "its end)", a, shown_number(v.range.step), z)
                                                             : fmt::format("the range [{} : {}] is empty (its start is above its end): "
-                                                                          "for a count down write [{} : -1 : {}]", a, z, a, z)});
+                                                                          "for a count down write [{} : -1 : {}]", a, z, a, z));
             }
             return v;
         }
@@ -452,17 +452,18 @@ Value Interp::eval_target(const ast::Expr& target, Env* env, const std::string& 
 }
 
 // A light or camera (any setting) written inside an operation's target is set as written:
-// the operation applies to shapes only. A warning, not again right after itself (a loop).
+// the operation applies to shapes only. A warning (once a place).
 void Interp::note_setting_in_target(const BuiltinInfo& info, Loc loc) {
     if (targets.empty()) return;
     const std::string msg = fmt::format("{}(...) is inside the target of {}, which applies to shapes only: the {} is set as written, "
                                         "not moved, turned or scaled (write it outside the operation)",
                                         info.name, targets.back(), info.name);
-    if (!scene.warnings.empty()) {
-        const Diagnostic& d = scene.warnings.back();
-        if (d.loc.file == loc.file && d.loc.line == loc.line && d.loc.col == loc.col && d.message == msg) return;
-    }
-    scene.warnings.push_back({loc, msg});
+    warn(loc, msg);
+}
+
+void Interp::warn(Loc loc, std::string message) {
+    if (!warned.emplace(loc.file, loc.line, loc.col, message).second) return;
+    scene.warnings.push_back({loc, std::move(message)});
 }
 
 // ---------------------------------------------------------------- operators

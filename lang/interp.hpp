@@ -6,6 +6,7 @@
 #include <functional>
 #include <optional>
 #include <set>
+#include <tuple>
 #include <string_view>
 #include <unordered_map>
 #include <unordered_set>
@@ -131,6 +132,10 @@ public:
     Value call_math(const BuiltinInfo& info, std::vector<Value>& args, const std::vector<Loc>& locs, Loc loc);
     // A colour name (CSS, or #rrggbb) as linear RGB (lang/colours.cpp); an error at loc if unknown.
     Value colour_name(const std::string& name, Loc loc);
+    // A warning, kept once per place and text (code in a loop or a def called many times
+    // would otherwise keep one per run of it).
+    void warn(Loc loc, std::string message);
+    std::set<std::tuple<const SourceFile*, uint32_t, uint32_t, std::string>> warned;
 
     // --- helpers
     [[noreturn]] void fail(Loc loc, std::string msg);

@@ -196,7 +196,8 @@ constexpr const char* kDebugModifiers =
     " (OpenSCAD's debug modifiers # % * ! have no use here: delete it, or comment the statement out)";
 
 // A hint for OpenSCAD's syntax near a syntax error at `off`: a line that starts with
-// `include <` or `use <`, `each`, a debug modifier at a statement's start, a hex number.
+// `include <` or `use <`, `each`, a hex number, a debug modifier where a statement or a
+// modifier's target starts, a `let (...)` expression.
 std::string openscad_hint(std::string_view t, size_t off) {
     size_t start = off < t.size() ? off : previous_token_end(t, off);  // (the error may be at the end of the file)
     while (start > 0 && t[start - 1] != '\n') --start;
@@ -248,7 +249,7 @@ CompileError syntax_error(const SourceFile& f, size_t off, std::string msg) {
             }
             std::string hint = lone_amp ? fmt::format(" (did you mean '{0}{0}'?)", static_cast<char>(c))
                                : c == '\'' ? " (strings are written in double quotes)"
-                               : c == '$' && t.substr(off, 2) == "$t" && !(off + 2 < t.size() && (std::isalnum(static_cast<unsigned char>(t[off + 2])) || t[off + 2] == '_')) ? " (OpenSCAD's $t is sdfc's `time`, in seconds: render --frames A:B --fps N)"
+                               : c == '$' && word_at(t, off + 1) == "t" ? " (OpenSCAD's $t is sdfc's `time`, in seconds: render --frames A:B --fps N)"
                                : c == '$'  ? " (OpenSCAD's $fn, $fa and $fs have no use here: sdfc's surfaces are exact)"
                                : c == '#' && target_start(t, off) ? std::string(kDebugModifiers)
                                            : "";
