@@ -132,15 +132,17 @@ Loc loc_at(const SourceFile& f, size_t off) {
     return Loc{&f, line, static_cast<uint32_t>(off - f.line_starts[line - 1] + 1)};
 }
 
-// The end of the last token before `off` (which follows that token's whitespace and
-// comments): where a missing ';' belongs.
+bool name_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
 // The name (letters, digits, '_') that starts at off; empty if none does.
 std::string_view word_at(std::string_view t, size_t off) {
     size_t e = off;
-    while (e < t.size() && (std::isalnum(static_cast<unsigned char>(t[e])) || t[e] == '_')) ++e;
+    while (e < t.size() && name_char(t[e])) ++e;
     return t.substr(off, e - off);
 }
 
+// The end of the last token before `off` (which follows that token's whitespace and
+// comments): where a missing ';' belongs.
 size_t previous_token_end(std::string_view t, size_t off) {
     size_t i = 0, last = 0;
     while (i < off && i < t.size()) {
@@ -180,16 +182,19 @@ bool is_keyword(std::string_view w) {
     return std::find(std::begin(kws), std::end(kws), w) != std::end(kws);
 }
 
-// Whether `off` starts a statement: only blanks and comments between it and the file's
-// start, a ';', a '{' or a '}'.
-bool statement_start(std::string_view t, size_t off) {
-    off = previous_token_end(t, off);  // (past blanks and comments)
-    return off == 0 || t[off - 1] == ';' || t[off - 1] == '{' || t[off - 1] == '}';
-}
-// ... or where a modifier's target starts (after its ')').
-bool target_start(std::string_view t, size_t off) {
-    const size_t p = previous_token_end(t, off);
-    return statement_start(t, off) || (p > 0 && t[p - 1] == ')');
+// Whether a statement or a modifier's target may start after the token ending at `prev`
+// (previous_token_end): the file's start, a ';', a '{', a '}' or a ')'.
+bool target_after(std::string_view t, size_t prev) { return prev == 0 || std::strchr(";{})", t[prev - 1]) != nullptr; }
+
+// Whether the whole word `w` starts somewhere in t[from, last] and is followed by `next`
+// (right after it, or past blanks).
+bool word_then(std::string_view t, size_t from, size_t last, std::string_view w, char next, bool past_blanks) {
+    for (size_t e = t.find(w, from); e != std::string_view::npos && e <= last; e = t.find(w, e + 1)) {
+        size_t k = e + w.size();
+        while (past_blanks && k < t.size() && t[k] == ' ') ++k;
+        if ((e == 0 || !name_char(t[e - 1])) && k < t.size() && t[k] == next) return true;
+    }
+    return false;
 }
 
 constexpr const char* kDebugModifiers =
@@ -206,25 +211,18 @@ std::string openscad_hint(std::string_view t, size_t off) {
     size_t after = start + first.size();
     while (after < t.size() && t[after] == ' ') ++after;
     if ((first == "include" || first == "use") && after < t.size() && t[after] == '<') return habit_hint(first);
-    size_t w = previous_token_end(t, off);  // the word before the error
+    const size_t w = previous_token_end(t, off);  // the word before the error
     size_t b = w;
-    while (b > 0 && (std::isalnum(static_cast<unsigned char>(t[b - 1])) || t[b - 1] == '_')) --b;
-    for (size_t e = t.substr(0, off).find("each", start); e != std::string_view::npos && e < off; e = t.substr(0, off).find("each", e + 1))
-        if ((e == 0 || !(std::isalnum(static_cast<unsigned char>(t[e - 1])) || t[e - 1] == '_')) && e + 4 < t.size() && t[e + 4] == ' ')
-            return habit_hint("each");
+    while (b > 0 && name_char(t[b - 1])) --b;
+    if (off >= 4 && word_then(t, start, off - 4, "each", ' ', false)) return habit_hint("each");
     if (off < t.size() && (t[off] == 'x' || t[off] == 'X') && w > 0 && t[w - 1] == '0' && b + 1 == w)
         return " (sdfc has no hex numbers: write the number in decimal)";
     const bool stray_close = off + 1 < t.size() && t[off] == '*' && t[off + 1] == '/';  // (a comment's end)
-    if (off < t.size() && (t[off] == '*' || t[off] == '%') && !stray_close && target_start(t, off)) return kDebugModifiers;
-    // let (a = 2) ...: OpenSCAD's let expression, on the line before the error
-    const std::string_view upto = t.substr(0, std::min(t.size(), off + 3));  // (a let at the error itself too)
-    for (size_t e = upto.find("let", start); e != std::string_view::npos && e <= off; e = upto.find("let", e + 1)) {
-        size_t k = e + 3;
-        while (k < t.size() && t[k] == ' ') ++k;
-        if ((e == 0 || !(std::isalnum(static_cast<unsigned char>(t[e - 1])) || t[e - 1] == '_')) && k < t.size() && t[k] == '(')
-            return " (sdfc's let is a statement, `let x = 2;`, whose name holds for the rest of its block; in a def, "
-                   "`def f(x) = { let y = x * 2; y + 1 };`)";
-    }
+    if (off < t.size() && (t[off] == '*' || t[off] == '%') && !stray_close && target_after(t, w)) return kDebugModifiers;
+    // let (a = 2) ...: OpenSCAD's let expression, on the line up to the error (or at it)
+    if (word_then(t, start, off, "let", '(', true))
+        return " (sdfc's let is a statement, `let x = 2;`, whose name holds for the rest of its block; in a def, "
+               "`def f(x) = { let y = x * 2; y + 1 };`)";
     return "";
 }
 
@@ -251,7 +249,7 @@ CompileError syntax_error(const SourceFile& f, size_t off, std::string msg) {
                                : c == '\'' ? " (strings are written in double quotes)"
                                : c == '$' && word_at(t, off + 1) == "t" ? " (OpenSCAD's $t is sdfc's `time`, in seconds: render --frames A:B --fps N)"
                                : c == '$'  ? " (OpenSCAD's $fn, $fa and $fs have no use here: sdfc's surfaces are exact)"
-                               : c == '#' && target_start(t, off) ? std::string(kDebugModifiers)
+                               : c == '#' && target_after(t, previous_token_end(t, off)) ? std::string(kDebugModifiers)
                                            : "";
             return CompileError(loc_at(f, off), fmt::format("unexpected character {}{}", what, hint));
         }

@@ -120,9 +120,7 @@ bool clip_placed(const Graph& g, const Shape& s, const glm::mat3& r, const glm::
         }
         case ShapeKind::Rotate: {
             if (!constant() || s.children.empty()) break;
-            glm::mat3 m(1.0f);  // world = m * local (bounds_Rotate)
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j) m[j][i] = g.const_value(s.params.at(RotateP::m + size_t(i) * 3 + size_t(j)));
+            const glm::mat3 m = rotation_rows([&](size_t k) { return g.const_value(s.params.at(RotateP::m + k)); });
             return clip_placed(g, *s.children[0], r * m, t, box, half_spaces);
         }
         case ShapeKind::Plane: {
@@ -143,11 +141,7 @@ bool clip_placed(const Graph& g, const Shape& s, const glm::mat3& r, const glm::
     const Bounds b = shape_bounds(g, s);
     if (is_empty(b)) return true;
     if (!b.finite()) return false;
-    for (int i = 0; i < 8; ++i) {
-        const glm::vec3 c{i & 1 ? b.hi.x : b.lo.x, i & 2 ? b.hi.y : b.lo.y, i & 4 ? b.hi.z : b.lo.z};
-        const glm::vec3 q = r * c + t;
-        box = join(box, Bounds{q, q});
-    }
+    box = join(box, mapped_box(b, r, t));
     return true;
 }
 

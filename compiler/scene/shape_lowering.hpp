@@ -88,6 +88,23 @@ inline Bounds grow(Bounds b, float r) {
 }
 inline Bounds join(const Bounds& a, const Bounds& b) { return Bounds{glm::min(a.lo, b.lo), glm::max(a.hi, b.hi)}; }
 inline Bounds meet(const Bounds& a, const Bounds& b) { return Bounds{glm::max(a.lo, b.lo), glm::min(a.hi, b.hi)}; }
+// The box around a finite box mapped by p -> m p + t (its 8 corners).
+inline Bounds mapped_box(const Bounds& c, const glm::mat3& m, const glm::vec3& t = glm::vec3(0.0f)) {
+    Bounds out = empty();
+    for (int i = 0; i < 8; ++i) {
+        const glm::vec3 q = m * glm::vec3{i & 1 ? c.hi.x : c.lo.x, i & 2 ? c.hi.y : c.lo.y, i & 4 ? c.hi.z : c.lo.z} + t;
+        out = join(out, Bounds{q, q});
+    }
+    return out;
+}
+// A rotation's matrix (world = m * local) from its 9 row-major entries (RotateP::m).
+template <class Entry>
+glm::mat3 rotation_rows(Entry entry) {
+    glm::mat3 m(1.0f);
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) m[c][r] = entry(size_t(r) * 3 + size_t(c));
+    return m;
+}
 inline bool is_empty(const Bounds& b) { return b.lo.x > b.hi.x || b.lo.y > b.hi.y || b.lo.z > b.hi.z; }
 
 // One pair per row of shapes.def. A primitive returns its distance and Lipschitz bound (the

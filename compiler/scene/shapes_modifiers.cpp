@@ -160,13 +160,7 @@ namespace {
 Bounds mapped(const BoundsIn& b, const glm::mat3& m) {
     Bounds c = b.child();
     if (is_empty(c) || !c.finite()) return is_empty(c) ? c : infinite();
-    Bounds out = empty();
-    for (int i = 0; i < 8; ++i) {
-        glm::vec3 corner{i & 1 ? c.hi.x : c.lo.x, i & 2 ? c.hi.y : c.lo.y, i & 4 ? c.hi.z : c.lo.z};
-        glm::vec3 q = m * corner;
-        out = join(out, Bounds{q, q});
-    }
-    return out;
+    return mapped_box(c, m);
 }
 }  // namespace
 
@@ -178,10 +172,7 @@ Lowered lower_Rotate(L& l, const Shape& s, const Vec3N& p, const MaterialN* inhe
     return child(l, s, q, inherited);
 }
 Bounds bounds_Rotate(const BoundsIn& b) {
-    glm::mat3 m(1.0f);
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) m[c][r] = b.v.at(RotateP::m + r * 3 + c);
-    return mapped(b, m);
+    return mapped(b, rotation_rows([&](size_t k) { return b.v.at(RotateP::m + k); }));
 }
 
 Lowered lower_Scale(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
