@@ -242,6 +242,8 @@ int cmd_render(Args& a) {
     for (size_t k = 0; k < items; ++k) my_items += k % size_t(shard.count) == size_t(shard.index);
     if (!shard.from.empty() && !quiet)
         std::fprintf(stderr, "sdfc: shard %d/%d (%s): %zu of %zu pictures\n", shard.index, shard.count, shard.from.c_str(), my_items, items);
+    else if (my_items == 0 && !quiet)  // (more tasks than pictures: not an error, but say so)
+        std::fprintf(stderr, "sdfc: shard %d/%d: none of the %zu pictures\n", shard.index, shard.count, items);
     if (*out == "-" && !ro.aovs.empty() && fmt_ext != "exr")
         throw UsageError("--aov to standard output needs --format exr (as channels: side files need a file name)");
     // The outputs can be written (folder, format, not a directory...) before any work.

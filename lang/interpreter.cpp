@@ -1,6 +1,7 @@
 // Statements and blocks: running a file, scopes, loops, imports. Expressions, calls and
 // operators are in expressions.cpp; builtins (shapes, operations, settings, math) in builtins.cpp.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -223,7 +224,14 @@ Value Interp::defined_value(size_t k, const ast::Stmt& let, Env* env) {
         return v;
     } catch (const CompileError& e) {
         const auto& diags = e.diagnostics();
-        throw DefineError(fmt::format("{}: {}", what, diags.empty() ? std::string("not a value") : diags.front().message));
+        std::string msg = diags.empty() ? std::string("not a value") : diags.front().message;
+        // A bare word taken for a name where the script's let is a string: the shell ate
+        // the quotes.
+        const bool word = let.value && let.value->kind == ast::ExprKind::String && !d.value.empty() && std::all_of(d.value.begin(), d.value.end(), [](char c) {
+            return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '#';
+        });
+        if (word && msg.rfind("unknown name", 0) == 0 && msg.find('(') == std::string::npos) msg += fmt::format(" (a string is quoted for the shell: -D '{}=\"{}\"')", d.name, d.value);
+        throw DefineError(fmt::format("{}: {}", what, msg));
     }
 }
 

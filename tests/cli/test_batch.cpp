@@ -61,6 +61,12 @@ TEST_CASE("render --shard I/N renders the frames k with k mod N = I, and the var
     auto told = run_sdfc("render " + q(s) + " --frames 0:5 --width 16 --height 12 -o " + q(fresh_dir("told") + "/f{frame}.png"),
                          "SLURM_ARRAY_TASK_ID=1 SLURM_ARRAY_TASK_COUNT=3");
     CHECK(told.err.rfind("sdfc: shard 1/3 (SLURM_ARRAY_TASK_ID): 2 of 6 pictures\n", 0) == 0);
+    // A task with none of the pictures (more tasks than pictures) says so, and succeeds.
+    const std::string none = fresh_dir("none");
+    auto idle = run_sdfc("render " + q(s) + " --frames 0:5 --width 16 --height 12 -o " + q(none + "/f{frame}.png") + " --shard 7/8");
+    CHECK(idle.status == 0);
+    CHECK(idle.err == "sdfc: shard 7/8: none of the 6 pictures\n");
+    CHECK(frames_of(none).empty());
     // One picture under a scheduler is not shared out (no flag); errors say why.
     const std::string one = fresh_dir("one");
     CHECK(run_sdfc("render " + q(s) + " --width 16 --height 12 -q -o " + q(one + "/a.png"), "SLURM_ARRAY_TASK_ID=3 SLURM_ARRAY_TASK_COUNT=4").status == 0);

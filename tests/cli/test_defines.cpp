@@ -45,6 +45,12 @@ TEST_CASE("the flag -D: its errors are command-line errors, with did-you-mean") 
     auto name = run_sdfc("check " + q(s) + " -D size=nope");
     CHECK(name.status == 2);
     CHECK(name.err == "sdfc: error: -D size=nope: unknown name 'nope'\n");
+    // A string's quotes eaten by the shell.
+    const std::string text = test::write_temp("defines_text.sdf", "let finish = \"gold\";\ncolor(finish) sphere(1);\n");
+    auto word = run_sdfc("check " + q(text) + " -D finish=red");
+    CHECK(word.status == 2);
+    CHECK(word.err == "sdfc: error: -D finish=red: unknown name 'red' (a string is quoted for the shell: -D 'finish=\"red\"')\n");
+    CHECK(run_sdfc("check " + q(text) + " -D 'finish=\"red\"'").status == 0);
     auto form = run_sdfc("check " + q(s) + " -D size");
     CHECK(form.status == 2);
     CHECK(form.err == "sdfc: error: -D takes NAME=VALUE (a top-level let of the script and an expression), not 'size'\n");

@@ -119,3 +119,23 @@ TEST_CASE("8-bit files hold straight colour with alpha, hdr has none, its side f
     CHECK(aov_side_path((dir / "f.png").string(), "depth") == (dir / "f.depth.png").string());
     fs::remove_all(dir);
 }
+
+TEST_CASE("pgm is grey: the colour's luminance, one channel, and no alpha", "[image][alpha]") {
+    const fs::path dir = dir_for("pgm");
+    auto c = test::compile_text(kScene);
+    const Image img = render(c->cs, RenderOptions{});
+    const std::string pgm = (dir / "a.pgm").string();
+    write_image(pgm, img);
+    auto in = OIIO::ImageInput::open(pgm);
+    REQUIRE(in);
+    CHECK(in->spec().nchannels == 1);
+    std::vector<uint8_t> px(size_t(48) * 32);
+    in->read_image(0, 0, 0, 1, OIIO::TypeDesc::UINT8, px.data());
+    const float* p = &img.pixels[(16 * 48 + 24) * 3];
+    CHECK(px[16 * 48 + 24] == uint8_t(std::lround(linear_to_srgb(0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]) * 255)));
+    CHECK(px[16 * 48 + 24] != px[0]);  // the sphere against the background
+    RenderOptions o;
+    o.alpha = true;
+    CHECK_THROWS_WITH(write_image(pgm, render(c->cs, o)), "cannot write '" + pgm + "': pgm has no alpha channel (use png or exr)");
+    fs::remove_all(dir);
+}

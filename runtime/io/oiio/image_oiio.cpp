@@ -286,6 +286,18 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
         write_atomic(path, as, img.width, img.height, fnames, OIIO::TypeDesc::FLOAT, buf.data(), true);
         return;
     }
+    if ((ext == ".pgm" || ext == ".ppm" || ext == ".pnm" || ext == ".pbm") && oc == 4)
+        throw std::runtime_error("cannot write '" + path + "': " + ext.substr(1) + " has no alpha channel (use png or exr)");
+    if (ext == ".pgm" && oc == 3) {
+        // Grey: the luminance (Rec. 709) of the linear colour, sRGB-encoded.
+        std::vector<uint8_t> grey(n);
+        for (size_t i = 0; i < n; ++i) {
+            const float* p = &img.pixels[i * img.channels];
+            grey[i] = to_u8(linear_to_srgb(0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]));
+        }
+        write_atomic(path, as, img.width, img.height, {"Y"}, OIIO::TypeDesc::UINT8, grey.data(), false);
+        return;
+    }
     // 8-bit, sRGB-encoded colour; alpha stays linear, and the colour straight (not
     // premultiplied by it), as PNG and the like hold it.
     std::vector<uint8_t> buf(n * oc);
