@@ -24,6 +24,17 @@ Value Interp::call_math(const BuiltinInfo& info, std::vector<Value>& args, const
         else fail(locs[0], fmt::format("len takes a list, a vector, a range or a string, not {}", describe(a)));
         return Value::number(gr.constant(float(n)));
     }
+    if (info.id == B::Concat) {  // OpenSCAD's: lists and vectors give their elements, anything else itself
+        std::vector<Value> items;
+        for (const Value& a : args) {
+            if (a.t == VT::Vector)
+                for (int k = 0; k < a.n; ++k) items.push_back(Value::number(a.c[k]));
+            else if (a.t == VT::List) items.insert(items.end(), a.list->begin(), a.list->end());
+            else items.push_back(a);
+        }
+        return list_value(std::move(items), loc);
+    }
+    if (info.id == B::Lookup) return lookup(args, locs, loc);
     auto arity = [&](size_t lo, size_t hi) {
         if (args.size() < lo || args.size() > hi) {
             if (lo == hi) fail(loc, fmt::format("{} takes {} argument{}, not {}", info.name, lo, lo == 1 ? "" : "s", args.size()));
@@ -154,7 +165,8 @@ Value Interp::call_math(const BuiltinInfo& info, std::vector<Value>& args, const
                 return gr.mul(gr.unary(Op::Square, x), gr.sub(gr.constant(3), gr.mul(gr.constant(2), x)));
             });
         }
-        case B::Length: arity(1, 1); return Value::number(length(args[0]));
+        case B::Length:
+        case B::Norm: arity(1, 1); return Value::number(length(args[0]));
         case B::Distance: {
             arity(2, 2);
             Value d = componentwise2(args[0], args[1], loc, [&](NodeId x, NodeId y) { return gr.sub(x, y); });
@@ -235,6 +247,37 @@ Value Interp::make_param(std::vector<Value>& args, const std::vector<Loc>& locs,
     const int index = static_cast<int>(scene.params.size());
     scene.params.push_back(SceneParam{param_let, value, lo, hi, step, loc});
     return Value::number(g->with_imm(Op::Param, kNoNode, kNoNode, static_cast<float>(index)));
+}
+
+// OpenSCAD's lookup(key, [[k0, v0], [k1, v1], ...]): v linear between the keys (in any
+// order), the end values beyond them. The table is constant; the key may vary (a field's
+// point): then a chain of selects.
+Value Interp::lookup(std::vector<Value>& args, const std::vector<Loc>& locs, Loc loc) {
+    Graph& gr = *g;
+    if (args.size() != 2) fail(loc, fmt::format("lookup takes 2 arguments (a key and a table), not {}", args.size()));
+    NodeId key = num(args[0], locs[0], "lookup's key");
+    std::vector<std::pair<float, float>> rows;
+    auto row = [&](const Value& r) {
+        if (r.t != VT::Vector || r.n != 2 || !gr.is_const(r.c[0]) || !gr.is_const(r.c[1]))
+            fail(locs[1], fmt::format("lookup's table holds [key, value] pairs of constants, not {}", describe(r)));
+        rows.emplace_back(gr.const_value(r.c[0]), gr.const_value(r.c[1]));
+    };
+    const Value& t = args[1];
+    if (t.t != VT::List) fail(locs[1], fmt::format("lookup's table is a list of [key, value] pairs, not {}", describe(t)));
+    for (const Value& r : *t.list) row(r);
+    if (rows.empty()) fail(locs[1], "lookup's table is empty");
+    std::stable_sort(rows.begin(), rows.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    NodeId r = gr.constant(rows.back().second);
+    for (size_t i = rows.size() - 1; i-- > 0;) {
+        const auto [k0, v0] = rows[i];
+        const auto [k1, v1] = rows[i + 1];
+        // (equal keys: the later row's value from that key on)
+        NodeId u = k1 > k0 ? gr.clamp(gr.div(gr.sub(key, gr.constant(k0)), gr.constant(k1 - k0)), gr.constant(0.0f), gr.constant(1.0f))
+                           : gr.constant(1.0f);
+        NodeId seg = gr.add(gr.constant(v0), gr.mul(u, gr.constant(v1 - v0)));
+        r = gr.select(gr.binary(Op::Lt, key, gr.constant(k1)), seg, r);
+    }
+    return Value::number(checked(r, loc));
 }
 
 }  // namespace sdfc

@@ -56,7 +56,7 @@ std::vector<BuiltinInfo> make_table() {
         }
     }
     add(B::MaterialFn, "material", K::MaterialCtor, std::move(mat));
-    add(B::Color, "color", K::MaterialCtor, {req("color", P::Any)});  // [r, g, b] or a CSS name; named like material's
+    add(B::Color, "color", K::MaterialCtor, {req("color", P::Any), opt("alpha", P::Num, 1)});  // as material's; alpha: OpenSCAD's
     // Settings
     add(B::Camera, "camera", K::Setting,
         {opt("position", P::Vec3, 0, 0, 5), opt("target", P::Vec3, 0, 0, 0), opt("up", P::Vec3, 0, 1, 0), opt("fov", P::Num, 45),
@@ -429,6 +429,8 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
                         warn(b.loc(0), "color's alpha (the 4th component) is ignored: for see-through, "
                                                             "material(transparency = ...)");
                 }
+                if (b.has(1) && !(gr.is_const(b.val(1).c[0]) && gr.const_value(b.val(1).c[0]) == 1.0f))
+                    warn(b.loc(1), "color's alpha is ignored: for see-through, material(transparency = ...)");
             } else {
                 // `color` with no argument only makes sense applied; use the default.
             }

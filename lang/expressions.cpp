@@ -60,7 +60,6 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
         }
         case K::Vector: {
             std::vector<Value> items;
-            bool all_num = true;
             // A list comprehension, as OpenSCAD's: `[for (i = [0 : 9]) f(i)]` gives the
             // iterations' values; an `if` without `else` that is false gives none, and a `for`
             // (or an `if` choosing one) inside runs nested: `[for (i = ...) for (j = ...) i * j]`.
@@ -74,7 +73,7 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                     run_for(x.bindings, scope, x.loc, [&](Env* body) {
                         if (x.block) {
                             Value v = eval_block(*x.block, body, false);
-                            if (v.t != VT::None) all_num &= v.t == VT::Number, items.push_back(std::move(v));
+                            if (v.t != VT::None) items.push_back(std::move(v));
                         } else {
                             generate(*x.body, body);
                         }
@@ -89,7 +88,6 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                 }
                 Value v = eval(x, scope);
                 if (v.t == VT::None) return;
-                all_num &= v.t == VT::Number;
                 items.push_back(std::move(v));
             };
             for (const auto& el : e.elems) {
@@ -98,27 +96,8 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                     continue;
                 }
                 items.push_back(eval(*el, env));
-                all_num &= items.back().t == VT::Number;
             }
-            if (all_num && items.size() >= 2 && items.size() <= 4) {
-                NodeId c[4];
-                for (size_t i = 0; i < items.size(); ++i) c[i] = items[i].c[0];
-                return Value::vector(c, int(items.size()));
-            }
-            if (all_num && items.size() == 1) {
-                // [x] is a list of one number
-            }
-            Value v;
-            v.t = VT::List;
-            v.depth = 1;
-            for (const Value& it : items) v.depth = std::max(v.depth, it.depth + 1);
-            // Lists built by a loop (`l = [l];`) nest without nesting the syntax.
-            if (v.depth > uint32_t(opts.limits.max_nesting))
-                fail(e.loc, fmt::format("lists nested deeper than {} levels ({})", opts.limits.max_nesting,
-                                        opts.limits.max_nesting >= ast::ParseOptions::kMostNesting ? "the most --max-nesting allows"
-                                                                                                   : "raise it with --max-nesting"));
-            v.list = std::make_shared<const std::vector<Value>>(std::move(items));
-            return v;
+            return list_value(std::move(items), e.loc);
         }
         case K::Range: {
             Value v;
@@ -467,6 +446,29 @@ void Interp::warn(Loc loc, std::string message) {
 }
 
 // ---------------------------------------------------------------- operators
+
+// A list literal's value: 2 to 4 numbers are a vector, anything else a list.
+Value Interp::list_value(std::vector<Value> items, Loc loc) {
+    bool all_num = true;
+    for (const Value& it : items) all_num &= it.t == VT::Number;
+    if (all_num && items.size() >= 2 && items.size() <= 4) {
+        NodeId c[4];
+        for (size_t i = 0; i < items.size(); ++i) c[i] = items[i].c[0];
+        return Value::vector(c, int(items.size()));
+    }
+    // ([x] is a list of one number)
+    Value v;
+    v.t = VT::List;
+    v.depth = 1;
+    for (const Value& it : items) v.depth = std::max(v.depth, it.depth + 1);
+    // Lists built by a loop (`l = [l];`) nest without nesting the syntax.
+    if (v.depth > uint32_t(opts.limits.max_nesting))
+        fail(loc, fmt::format("lists nested deeper than {} levels ({})", opts.limits.max_nesting,
+                              opts.limits.max_nesting >= ast::ParseOptions::kMostNesting ? "the most --max-nesting allows"
+                                                                                         : "raise it with --max-nesting"));
+    v.list = std::make_shared<const std::vector<Value>>(std::move(items));
+    return v;
+}
 
 Value Interp::componentwise(const Value& a, Loc loc, const std::function<NodeId(NodeId)>& f) {
     Value r = a;

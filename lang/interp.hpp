@@ -146,6 +146,8 @@ public:
     std::optional<bool> const_truth(const Value& v, Loc loc);
     Value binary(ast::BinOp op, const Value& a, const Value& b, Loc loc);
     Value unary(ast::UnOp op, const Value& a, Loc loc);
+    Value list_value(std::vector<Value> items, Loc loc);
+    Value lookup(std::vector<Value>& args, const std::vector<Loc>& locs, Loc loc);
     Value componentwise(const Value& a, Loc loc, const std::function<NodeId(NodeId)>& f);
     Value componentwise2(const Value& a, const Value& b, Loc loc, const std::function<NodeId(NodeId, NodeId)>& f);
     NodeId checked(NodeId n, Loc loc);  // a constant must be finite

@@ -141,6 +141,26 @@ void make_programs(const Graph& g, NodeId distance, const std::vector<NodeId>& r
     if (shading_error) std::rethrow_exception(shading_error);
 }
 
+// A script without camera() whose scene holds the default camera's place (a model in
+// millimetres, as OpenSCAD's are, around a camera at [0, 0, 5]) is seen from outside
+// instead: from the front, right and above (as OpenSCAD's first view), from where its
+// bounding sphere fills the vertical field of view. Elsewhere the default stays (LANGUAGE.md section 8).
+void frame_default_camera(CompiledScene& cs) {
+    const Bounds& b = cs.bounds.finite() ? cs.bounds : cs.solid_bounds;
+    if (!b.finite() || !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) return;
+    ResolvedCamera& cam = cs.camera;
+    if (!glm::all(glm::greaterThanEqual(cam.position, b.lo)) || !glm::all(glm::lessThanEqual(cam.position, b.hi))) return;
+    const glm::vec3 centre = 0.5f * (b.lo + b.hi);
+    const float radius = 0.5f * glm::length(b.hi - b.lo);
+    const float dist = 1.05f * radius / std::sin(glm::radians(cam.fov) * 0.5f);
+    if (!std::isfinite(dist) || !(dist > 0.0f)) return;
+    ResolvedCamera framed = cam;
+    framed.target = centre;
+    framed.position = centre + glm::normalize(glm::vec3(0.6f, 0.5f, 1.0f)) * dist;  // front, right and above
+    framed.ortho_height = 2.1f * radius;
+    if (camera_problem(framed).empty()) cam = framed;
+}
+
 }  // namespace
 
 CompiledScene compile_scene(const Scene& scene) {
@@ -192,6 +212,7 @@ CompiledScene compile_scene(const Scene& scene) {
     cs.is_2d = scene.is_2d;
     cs.raw_field = scene.raw_field;
     cs.time = scene.time;
+    if (!c.loc.known() && !scene.is_2d && !scene.raw_field) frame_default_camera(cs);
     return cs;
 }
 

@@ -170,6 +170,21 @@ TEST_CASE("scene settings are read") {
     CHECK(s.render.max_bounces == 1);
 }
 
+TEST_CASE("without camera(), a scene around the default camera is seen from outside, framed") {
+    // A model in millimetres (as OpenSCAD's): the default camera at [0, 0, 5] is inside it.
+    auto compiled = test::compile_text("translate([0, 10, 0]) box(40);");
+    const CompiledScene& big = compiled->cs;
+    CHECK(big.camera.target.x == Approx(0.0f).margin(1e-5));
+    CHECK(big.camera.target.y == Approx(10.0f));
+    const float dist = glm::length(big.camera.position - big.camera.target);
+    CHECK(dist == Approx(1.05f * 20.0f * std::sqrt(3.0f) / std::sin(glm::radians(22.5f))).epsilon(0.01));
+    CHECK(big.camera.position.z > 20.0f);  // outside the box, in front of it
+    CHECK(test::dist(big, big.camera.position.x, big.camera.position.y, big.camera.position.z) > 0.0f);
+    // Elsewhere, and with a camera(), the camera stays where it was put.
+    CHECK(test::compile_text("sphere(1);")->cs.camera.position == glm::vec3(0, 0, 5));
+    CHECK(test::compile_text("camera(position = [0, 0, 5]); box(40);")->cs.camera.position == glm::vec3(0, 0, 5));
+}
+
 TEST_CASE("materials are values and modifiers, the inner one wins") {
     auto c = test::compile_text(
         "let gold = material(color = [0.9, 0.7, 0.2], specular = 0.6, shininess = 64);\n"
