@@ -112,15 +112,17 @@ CompiledScene build(SourceManager& sm, const std::string& path, Common& c, std::
 std::string view_problem(const CompiledScene& cs) {
     if (cs.is_2d || cs.raw_field || cs.distance.outputs.empty()) return "";
     const Bounds& b = cs.bounds.finite() ? cs.bounds : cs.solid_bounds;
-    if (!b.finite() || !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) return "";
     const ResolvedCamera& cam = cs.camera;
     const glm::vec3 c = cam.position;
-    if (glm::all(glm::greaterThanEqual(c, b.lo)) && glm::all(glm::lessThanEqual(c, b.hi))) {
+    auto inside = [&] {
         float d = 0.0f;
         sample_batch(cs.distance, &c.x, &c.y, &c.z, 1, cs.time, &d);
-        if (d < 0.0f) return fmt::format("the camera (at {}, {}, {}) is inside the scene's solid: the picture shows it from within", c.x, c.y, c.z);
-        return "";
-    }
+        return d < 0.0f ? fmt::format("the camera (at {}, {}, {}) is inside the scene's solid: the picture shows it from within", c.x, c.y, c.z)
+                        : std::string();
+    };
+    // (unbounded: a repeat, a custom field, a floor the camera is under)
+    if (!b.finite() || !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) return inside();
+    if (glm::all(glm::greaterThanEqual(c, b.lo)) && glm::all(glm::lessThanEqual(c, b.hi))) return inside();
     if (cam.orthographic) return "";
     const glm::vec3 f = glm::normalize(cam.target - c), r = glm::normalize(glm::cross(f, cam.up)), u = glm::cross(r, f);
     const float th = std::tan(glm::radians(cam.fov) * 0.5f), tw = th * float(cs.render.width) / float(std::max(cs.render.height, 1));

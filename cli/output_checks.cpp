@@ -124,7 +124,16 @@ void check_field_finite(const Scene& s, const CompiledScene& cs) {
 
 void check_field_finite(const Scene& s, const Program& distance, const std::vector<glm::vec3>& at) {
     // (a shape sized by `time` may be fine later on: `sphere(1 / time)`)
-    if (!distance.uses_time) check_finite_at(s, distance, at, 0.0f);
+    if (distance.uses_time) return;
+    // A shader's params (uniforms, which the VM reads as 0) at the values the page starts with.
+    Program p = distance;
+    for (Instr& in : p.code)
+        if (in.op == Op::Param) {
+            const size_t k = static_cast<size_t>(in.k);
+            in.op = Op::Const;
+            in.k = k < s.params.size() ? s.params[k].value : 0.0f;
+        }
+    check_finite_at(s, p, at, 0.0f);
 }
 
 }  // namespace sdfc::cli

@@ -29,9 +29,14 @@ Interval eval_interval(Op op, Interval a, Interval b, Interval c, float k, uint8
 // The interval of a 1-Lipschitz bound over a box whose diagonal is `diagonal` long,
 // tightened with the bound's value at the box's centre: it is within half the diagonal of
 // it (the margin covers the floats). Rescues fields whose intervals are weak far away.
+// An unknown interval (NaN: the arithmetic lost track, as in a fractal's escape loop)
+// stays unknown: a field written as a distance estimate near its surface (a Mandelbulb's
+// 0.5 log(r) r / dr) is far above the distance far from it, and a big cell's centre value
+// would then "prove" the cell empty, surface and all.
 inline Interval tighten_by_centre(Interval v, float centre, float diagonal) {
+    if (std::isnan(v.lo) || std::isnan(v.hi)) return v;
     const float r = 0.5f * diagonal * (1.0f + 1e-5f) + 1e-6f * (1.0f + std::fabs(centre));
-    if (!(v.lo >= centre - r)) v.lo = centre - r;  // also replaces NaN
+    if (!(v.lo >= centre - r)) v.lo = centre - r;
     if (!(v.hi <= centre + r)) v.hi = centre + r;
     return v;
 }

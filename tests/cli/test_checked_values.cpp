@@ -81,6 +81,12 @@ TEST_CASE("a distance that overflowed to -infinity is refused at compile time") 
     CHECK(run_sdfc("glsl " + q(test::write_temp("bigok_glsl.sdf", "scale(1e10) sphere(1e10);\n"))).status == 0);
     // A size that depends on time may overflow at time 0 only: the shader is written.
     CHECK(run_sdfc("glsl " + q(test::write_temp("time_glsl.sdf", "sphere(1 / time);\n"))).status == 0);
+    // A param (a uniform) is checked at its value, not at 0: polar_repeat(0) has no copies.
+    const std::string counts = test::write_temp("param_count_glsl.sdf",
+                                                "let n = param(4, 2, 6, 1);\nlet steps = param(3, 1, 6, 1);\n"
+                                                "polar_repeat(n) translate([1, 0, 0]) sphere(0.2);\n"
+                                                "stairs_union(0.3, steps) { sphere(1); translate([1, 0, 0]) box(1); }\n");
+    for (const char* target : {"shadertoy", "html"}) CHECK(run_sdfc("glsl " + q(counts) + " --target " + target).status == 0);
 }
 
 TEST_CASE("math messages: normalize of a tiny vector and pow of a negative number") {

@@ -94,4 +94,10 @@ TEST_CASE("render warns when the camera is inside the solid or looks away from t
     const std::string fine = test::write_temp("view_fine.sdf", "camera(position = [0, 0, 150]); sphere(20);\n");
     CHECK(run_sdfc("render " + q(fine) + " -o " + q(out) + " --width 8 --height 8").err.find("warning") == std::string::npos);
     CHECK(run_sdfc("render " + q(in) + " -o " + q(out) + " --width 8 --height 8 -q").err.empty());
+    // Unbounded scenes too: a repetition, a field.
+    for (const char* body : {"repeat([2, 2, 2]) sphere(0.4);", "field (p) -> length(mod(p + 1, 2) - 1) - 0.4;"}) {
+        const std::string rep = test::write_temp("view_repeat.sdf", std::string("camera(position = [0, 2, 6]);\n") + body + "\n");
+        CHECK(run_sdfc("render " + q(rep) + " -o " + q(out) + " --width 8 --height 8").err.rfind(
+                  "sdfc: warning: the camera (at 0, 2, 6) is inside the scene's solid: the picture shows it from within\n", 0) == 0);
+    }
 }
