@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "compiler/scene/lower.hpp"
+#include "lang/habits.hpp"
 #include "lang/interp.hpp"
 
 namespace sdfc {
@@ -146,23 +147,18 @@ struct Binder {
                     if (info.params.empty()) in.fail(a.loc, fmt::format("{} takes no arguments", info.name));
                     std::string names;
                     for (const auto& p : info.params) names += (names.empty() ? "" : ", ") + std::string(p.name);
-                    in.fail(a.loc, fmt::format("{} takes at most {} argument{} ({}), but more were given", info.name,
-                                               info.params.size(), info.params.size() == 1 ? "" : "s", names));
+                    in.fail(a.loc, fmt::format("{} takes at most {} argument{} ({}), but more were given{}", info.name,
+                                               info.params.size(), info.params.size() == 1 ? "" : "s", names,
+                                               openscad_argument_hint(info.name, "")));
                 }
                 idx = pos++;
             } else {
                 named = true;
                 auto it = std::find_if(info.params.begin(), info.params.end(), [&](const ParamSpec& p) { return a.name == p.name; });
                 if (it == info.params.end()) {
-                    // OpenSCAD's cylinder arguments: the sdfc forms.
-                    if (std::string_view(info.name) == "cylinder") {
-                        if (a.name == "r1" || a.name == "r2" || a.name == "d1" || a.name == "d2")
-                            in.fail(a.loc, fmt::format("cylinder has no parameter '{}': a cylinder with two radii is a cone, "
-                                                       "cone(h, r1, r2) (OpenSCAD's d1, d2 are twice those)", a.name));
-                        if (a.name == "d") in.fail(a.loc, "cylinder has no parameter 'd': give the radius, r = d / 2");
-                        if (a.name == "center")
-                            in.fail(a.loc, "cylinder has no parameter 'center': it is always centred on the origin, along y");
-                    }
+                    // OpenSCAD's arguments (d, center, r1, ...): the sdfc forms.
+                    if (const std::string why = openscad_argument_hint(info.name, a.name); !why.empty())
+                        in.fail(a.loc, fmt::format("{} has no parameter '{}': {}", info.name, a.name, why));
                     std::vector<std::string> names;
                     for (const auto& p : info.params) names.push_back(p.name);
                     std::string near = nearest_name(a.name, names);
@@ -571,13 +567,16 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
         // A CSG operation takes the statements of its block as operands; a single shape
         // that is itself a union of a block's statements is opened up. A `for` statement is
         // one operand, the union of its iterations; the union-like operations take its
-        // iterations as operands instead (the same union, and smooth ones blend them).
+        // iterations as operands instead (the same union, and smooth ones blend them), and
+        // so do the intersections whose only operand it is (OpenSCAD's intersection_for).
         s.kind = k;
         if (target->kind == ShapeKind::Union && !target->iterations && !target->children.empty()) s.children = target->children;
         else s.children = {target};
         const bool union_like = k == ShapeKind::Union || k == ShapeKind::SmoothUnion || k == ShapeKind::ChamferUnion ||
                                 k == ShapeKind::StairsUnion;
-        if (union_like && std::any_of(s.children.begin(), s.children.end(), [](const ShapePtr& c) { return c->iterations; })) {
+        const bool meets = k == ShapeKind::Intersection || k == ShapeKind::SmoothIntersection || k == ShapeKind::ChamferIntersection ||
+                           k == ShapeKind::StairsIntersection;
+        if ((union_like || (meets && s.children.size() == 1)) && std::any_of(s.children.begin(), s.children.end(), [](const ShapePtr& c) { return c->iterations; })) {
             std::vector<ShapePtr> flat;
             for (const ShapePtr& c : s.children) {
                 if (c->iterations) flat.insert(flat.end(), c->children.begin(), c->children.end());

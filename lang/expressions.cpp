@@ -1,5 +1,6 @@
 // Expressions, calls of user functions and shapes, and the operators: an expression's
 // value, built as nodes of the scene's graph. Statements are in interpreter.cpp.
+#include <cctype>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -56,6 +57,18 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
             if (habit_hint(e.text).empty())  // (else the names are not needed)
                 for (Env* s = env; s; s = s->parent)
                     for (const auto& [n, b] : s->vars) names.push_back(n);
+            if ((e.text == "module" || e.text == "function") && e.loc.known()) {
+                // OpenSCAD's `module NAME(...)`: its uses are not new errors.
+                const std::string_view ln = e.loc.file->line(e.loc.line);
+                size_t i = e.loc.col - 1;
+                if (ln.substr(i, e.text.size()) == e.text) {
+                    i += e.text.size();
+                    while (i < ln.size() && (ln[i] == ' ' || ln[i] == '\t')) ++i;
+                    size_t j = i;
+                    while (j < ln.size() && (std::isalnum(static_cast<unsigned char>(ln[j])) || ln[j] == '_')) ++j;
+                    if (j > i) failed_lets.insert(std::string(ln.substr(i, j - i)));
+                }
+            }
             fail(e.loc, unknown_name_message(e.text, names));
         }
         case K::Vector: {

@@ -23,7 +23,7 @@ inline std::string habit_hint(std::string_view name) {
         {"float", "sdfc has no types: `let a = 1.5;`"},
         {"int", "sdfc has no types: `let n = 3;`"},
         {"return", "a def's value is its expression, `def f(x) = x * 2;`, or the last expression of its { } block"},
-        {"intersection_for", "write `intersection { for (i = [0 : 2]) ... }`"},
+        {"intersection_for", "write `intersection { for (i = [0 : 2]) ... }`: a loop alone in an intersection gives its iterations"},
         {"union_for", "a `for` in a block unions its shapes: `union { for (i = [0 : 2]) ... }`"},
         {"echo", "sdfc has no echo: `sdfc eval SCENE --at X,Y,Z` prints distances"},
         {"include", "sdfc reads another file with `import \"file.sdf\";` (its defs and lets)"},
@@ -41,6 +41,27 @@ inline std::string habit_hint(std::string_view name) {
     };
     for (const Habit& h : kHabits)
         if (h.name == name) return " (" + std::string(h.hint) + ")";
+    return "";
+}
+
+// What OpenSCAD's argument `param` of `shape` is in sdfc, or "". With `param` empty: a hint
+// (" (...)") for more positional arguments than sdfc's form takes.
+inline std::string openscad_argument_hint(std::string_view shape, std::string_view param) {
+    const bool round = shape == "sphere" || shape == "circle" || shape == "cylinder";
+    if (param.empty())
+        return shape == "cylinder" ? " (OpenSCAD's cylinder(h, r1, r2) is sdfc's cone(h, r1, r2))" : "";
+    if (shape == "cylinder" && (param == "r1" || param == "r2" || param == "d1" || param == "d2"))
+        return "a cylinder with two radii is a cone, cone(h, r1, r2) (OpenSCAD's d1, d2 are twice those)";
+    if (round && param == "d") return "give the radius, r = d / 2";
+    if (param == "center") {
+        if (shape == "cylinder") return "it is always centred on the origin, along y";
+        if (shape == "box" || shape == "square" || shape == "sphere" || shape == "circle" || shape == "round_box" || shape == "cone" ||
+            shape == "hex_prism" || shape == "tri_prism")
+            return "sdfc's shapes are centred on the origin (OpenSCAD's center = true); translate one to move it";
+    }
+    if (shape == "rotate" && (param == "a" || param == "v"))
+        return "sdfc's forms are rotate([x, y, z]) (degrees about x, then y, then z), rotate(angle, axis) and rotate(y = angle)";
+    if (shape == "translate" && param == "v") return "give the vector alone, translate([x, y, z])";
     return "";
 }
 

@@ -298,7 +298,7 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
         case ast::StmtKind::Let:
         case ast::StmtKind::Var: {
             if (s.kind == ast::StmtKind::Var && !env->field_scope)
-                fail(s.loc, "'var' is only allowed inside a field block; use 'let' for a constant");
+                fail(s.loc, "'var' is only allowed inside a field block; use 'let' (outside a field block a value never changes)");
             // Built-in functions keep their names; the constants (pi, tau, e, time) may be shadowed.
             if (find_builtin(s.name))
                 fail(s.name_loc, fmt::format("'{}' is a built-in name and cannot be redefined", s.name));
@@ -328,11 +328,18 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
         }
         case ast::StmtKind::Assign: {
             Binding* b = env->find(s.name);
+            if (!b && failed_lets.count(s.name)) throw CompileError(std::vector<Diagnostic>{});  // its error is out already
             if (!b)
                 fail(s.name_loc, fmt::format("unknown variable '{0}' (a new name is declared with `let {0} = ...;`, or `var {0} = ...;` "
                                              "inside a field to change it later)",
                                              s.name));
-            if (!b->mut) fail(s.name_loc, fmt::format("'{}' is a constant (declared with let at line {}); declare it with var to reassign it", s.name, b->loc.line));
+            if (!b->mut && env->field_scope)
+                fail(s.name_loc, fmt::format("'{}' is a constant (declared with let at line {}); declare it with var to reassign it", s.name, b->loc.line));
+            if (!b->mut)  // (outside a field block nothing changes: OpenSCAD's rule too)
+                fail(s.name_loc, fmt::format("'{}' is a constant (declared with let at line {}): a value outside a field block never "
+                                             "changes; give the new value a new name, or compute it in one expression (a list "
+                                             "comprehension, a recursive def)",
+                                             s.name, b->loc.line));
             Value v = eval(*s.value, env);
             if (v.t != b->value.t || v.n != b->value.n)
                 fail(s.value->loc, fmt::format("'{}' holds {}; it cannot be assigned {}", s.name, describe(b->value), describe(v)));
@@ -364,6 +371,11 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             namespace fs = std::filesystem;
             fs::path base = fs::path(s.loc.file->path).parent_path();
             fs::path target = (base / s.name).lexically_normal();  // as diagnostics show it
+            std::string ext = target.extension().string();
+            for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+            if (ext == ".scad") fail(s.loc, "import reads sdfc scripts, not OpenSCAD's .scad files: port it (a module or function is a def)");
+            for (const char* mesh : {".stl", ".obj", ".off", ".3mf", ".ply", ".amf", ".dxf", ".svg"})
+                if (ext == mesh) fail(s.loc, fmt::format("import reads sdfc scripts (their defs and lets): a {} file cannot be imported", ext.substr(1)));
             std::error_code ec;
             std::string key = fs::weakly_canonical(target, ec).string();
             if (ec) fail(s.loc, fmt::format("cannot open '{}': {}", target.string(), ec.message()));

@@ -201,8 +201,8 @@ constexpr const char* kDebugModifiers =
     " (OpenSCAD's debug modifiers # % * ! have no use here: delete it, or comment the statement out)";
 
 // A hint for OpenSCAD's syntax near a syntax error at `off`: a line that starts with
-// `include <` or `use <`, `each`, a hex number, a debug modifier where a statement or a
-// modifier's target starts, a `let (...)` expression.
+// `include <` or `use <`, `each`, `import(`, a hex number, a debug modifier where a statement
+// or a modifier's target starts, a `let (...)` expression.
 std::string openscad_hint(std::string_view t, size_t off) {
     size_t start = off < t.size() ? off : previous_token_end(t, off);  // (the error may be at the end of the file)
     while (start > 0 && t[start - 1] != '\n') --start;
@@ -215,6 +215,8 @@ std::string openscad_hint(std::string_view t, size_t off) {
     size_t b = w;
     while (b > 0 && name_char(t[b - 1])) --b;
     if (off >= 4 && word_then(t, start, off - 4, "each", ' ', false)) return habit_hint("each");
+    if (off < t.size() && t[off] == '(' && t.substr(b, w - b) == "import")
+        return " (sdfc's `import \"file.sdf\";` reads a script's defs and lets: meshes such as .stl cannot be imported)";
     if (off < t.size() && (t[off] == 'x' || t[off] == 'X') && w > 0 && t[w - 1] == '0' && b + 1 == w)
         return " (sdfc has no hex numbers: write the number in decimal)";
     const bool stray_close = off + 1 < t.size() && t[off] == '*' && t[off + 1] == '/';  // (a comment's end)
@@ -248,7 +250,7 @@ CompileError syntax_error(const SourceFile& f, size_t off, std::string msg) {
             std::string hint = lone_amp ? fmt::format(" (did you mean '{0}{0}'?)", static_cast<char>(c))
                                : c == '\'' ? " (strings are written in double quotes)"
                                : c == '$' && word_at(t, off + 1) == "t" ? " (OpenSCAD's $t is sdfc's `time`, in seconds: render --frames A:B --fps N)"
-                               : c == '$'  ? " (OpenSCAD's $fn, $fa and $fs have no use here: sdfc's surfaces are exact)"
+                               : c == '$'  ? " (OpenSCAD's $fn, $fa and $fs have no use here: sdfc's surfaces are exact; a 6-sided cylinder is hex_prism(h, r))"
                                : c == '#' && target_after(t, previous_token_end(t, off)) ? std::string(kDebugModifiers)
                                            : "";
             return CompileError(loc_at(f, off), fmt::format("unexpected character {}{}", what, hint));

@@ -51,6 +51,9 @@ void add_operation_cases(std::vector<Case>& out) {
     // (LANGUAGE.md section 4; as in OpenSCAD).
     s.script("difference {\n for (x = [-1, 1]) translate([x, 0, 0]) sphere(0.5);\n sphere(0.2);\n}").at(1, 0, 0, -0.5).at(-1, 0, 0, -0.5).at(0, 0, 0, 0.5);
     s.script("intersection { for (x = [-1, 1]) translate([x * 0.5, 0, 0]) sphere(1); box(10); }").at(1.4f, 0, 0, -0.1f);
+    // ... but a loop alone in an intersection gives its iterations (OpenSCAD's intersection_for).
+    s.script("intersection { for (x = [-1, 1]) translate([x * 0.5, 0, 0]) sphere(1); }").at(0, 0, 0, -0.5f).greater(1.4f, 0, 0, 0);
+    s.script("smooth_intersection(0.1) { for (x = [-1, 1]) translate([x * 0.5, 0, 0]) sphere(1); }").greater(1.4f, 0, 0, 0);
     // Cut by a loop: the rest of a difference may be a loop too.
     s.script("difference { box(4); for (z = [-1, 1]) translate([0, 0, z]) sphere(0.5); }").at(0, 0, 1, 0.5).less(0, 0, 0, 0);
     // A lone loop is the first operand and nothing is subtracted.

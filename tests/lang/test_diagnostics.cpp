@@ -126,10 +126,26 @@ TEST_CASE("a def or an assignment that failed is reported once, not again as an 
 }
 
 TEST_CASE("var is for field blocks, let cannot be reassigned") {
-    CHECK(first_error_line("var x = 1;") == "test.sdf:1:1: error: 'var' is only allowed inside a field block; use 'let' for a constant");
+    CHECK(first_error_line("var x = 1;") == "test.sdf:1:1: error: 'var' is only allowed inside a field block; use 'let' (outside a field block a value never changes)");
     CHECK(first_error_line("field (p) -> { let d = 1; d = 2; d };") ==
           "test.sdf:1:27: error: 'd' is a constant (declared with let at line 1); declare it with var to reassign it");
     CHECK(first_error_line("let a = 1;\nlet a = 2;") == "test.sdf:2:5: error: 'a' is already defined in this scope (at line 1)");
+    // Outside a field block, var is no way out: the message says what is.
+    CHECK(first_error_line("let a = 1;\na = 2;\nsphere(a);") ==
+          "test.sdf:2:1: error: 'a' is a constant (declared with let at line 1): a value outside a field block never changes; give the "
+          "new value a new name, or compute it in one expression (a list comprehension, a recursive def)");
+    // A failed var or module leaves no follow-on errors at its uses.
+    for (const char* src : {"var a = 1;\na = 2;\nsphere(a);", "module m(s = 1) { sphere(s); }\nm();", "function f(x) = x;\nsphere(f(1));"}) {
+        INFO(src);
+        std::string e;
+        try {
+            test::compile_text(src);
+        } catch (const CompileError& err) {
+            e = err.formatted();
+        }
+        CHECK(e.find("error") != std::string::npos);
+        CHECK(e.find("test.sdf:2:") == std::string::npos);
+    }
 }
 
 TEST_CASE("an index must be a whole number within the vector or list") {
