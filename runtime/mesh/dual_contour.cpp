@@ -43,6 +43,22 @@ constexpr double kContouringShare = 0.25;  // of the progress bar, when the mesh
 
 // ------------------------------------------------------------------ vertices
 
+// A cell's box for its vertices, a hair inside its faces: two cells whose vertices both meet
+// their shared face (a sharp edge or a flat face lying on a grid plane) would otherwise put
+// them at one point, and the quads between them would have no area (an STL, which has no
+// indices, then has edges that are not shared by two triangles). Not at the meshed box's
+// walls: nothing lies beyond them, and a cut's vertices stay on them.
+void vertex_box(const Grid& g, glm::ivec3 cell, glm::vec3& lo, glm::vec3& hi) {
+    lo = g.corner(cell), hi = g.corner(cell + 1);
+    for (int k = 0; k < 3; ++k) {
+        const float ulp = FLT_EPSILON * std::max(std::fabs(lo[k]), std::fabs(hi[k]));
+        const float m = std::max(1e-3f * (hi[k] - lo[k]), 8.0f * ulp);
+        if (!(hi[k] - lo[k] > 4.0f * m)) continue;
+        if (lo[k] > g.lo[k]) lo[k] += m;
+        if (hi[k] < g.hi[k]) hi[k] -= m;
+    }
+}
+
 // Vertices the planes left off the surface (a cell that holds a crease but not the corner
 // its planes meet at, or normals blurred by a nearby crease) are moved onto it: Newton
 // steps along the gradient, kept in the cell. Those within 1/25 of a cell stay (on a curved
@@ -66,9 +82,10 @@ void settle_vertices(const Grid& g, Brick& b, Scratch& s) {
             const glm::vec3 grad(f.dx, f.dy, f.dz);
             const float g2 = glm::dot(grad, grad);
             if (!(g2 > 1e-12f) || !std::isfinite(g2)) continue;
-            const glm::ivec3 cell = b.cell_of[todo[j]];
+            glm::vec3 lo, hi;
+            vertex_box(g, b.cell_of[todo[j]], lo, hi);
             glm::vec3& v = b.verts[todo[j]];
-            v = glm::clamp(v - grad * (f.v / g2), g.corner(cell), g.corner(cell + 1));
+            v = glm::clamp(v - grad * (f.v / g2), lo, hi);
             todo[kept++] = todo[j];
         }
         todo.resize(kept);
@@ -155,7 +172,8 @@ void place_vertices(const Grid& g, Brick& b, Scratch& s) {
                 if (cfg == 0 || cfg == 255) continue;
                 const Patches& pt = patches(cfg, b.flipped[ci]);
                 const glm::ivec3 cell = b.at * kB + glm::ivec3(x, y, z);
-                const glm::vec3 lo = g.corner(cell), hi = g.corner(cell + 1);
+                glm::vec3 lo, hi;
+                vertex_box(g, cell, lo, hi);
                 for (int q = 0; q < pt.count; ++q) {
                     Qef qef;
                     for (int e = 0; e < 12; ++e) {

@@ -3,8 +3,10 @@
 // back.
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "mesh_checks.hpp"
@@ -124,6 +126,29 @@ TEST_CASE("mesh: a difference keeps its inner corners", "[mesh]") {
     CHECK(nearest_vertex(d.m, {0, 0, 0}) <= d.cell / 20.0f);
     CHECK(nearest_vertex(d.m, {-1, -1, -1}) <= d.cell / 20.0f);
     CHECK(nearest_vertex(d.m, {1, 0, 0}) <= d.cell / 20.0f);
+}
+
+TEST_CASE("mesh: edges and faces on grid planes give no two vertices one position (STL has no indices)", "[mesh]") {
+    // The hexagon's corners at x = +-0.5 and the slab's faces lie on planes of the grid.
+    const auto c = compile_text("difference { box([4, 1, 4]); rotate(y = 30) hex_prism(3, 0.5); }\n"
+                                "translate([0, 1.5, 0]) box([2, 1, 2]);\n");
+    mesh::MeshOptions o;
+    o.lo = glm::vec3(-1, -2, -1), o.hi = glm::vec3(1, 2, 1);
+    o.resolution = 40;
+    const mesh::Mesh m = mesh::mesh_scene(c->cs, o);
+    check_closed_manifold(m);
+    std::set<std::array<float, 3>> at;
+    for (const glm::vec3& v : m.positions) at.insert({v.x, v.y, v.z});
+    CHECK(at.size() == m.positions.size());
+    size_t flat = 0;
+    for (const auto& t : m.triangles)
+        flat += glm::length(glm::cross(m.positions[t[1]] - m.positions[t[0]], m.positions[t[2]] - m.positions[t[0]])) == 0.0f;
+    CHECK(flat == 0);
+    // The walls of the box meshed stay where they are.
+    float x0 = INFINITY, x1 = -INFINITY;
+    for (const glm::vec3& v : m.positions) x0 = std::min(x0, v.x), x1 = std::max(x1, v.x);
+    CHECK(x0 == -1.0f);
+    CHECK(x1 == 1.0f);
 }
 
 TEST_CASE("mesh: a torus has genus 1", "[mesh]") {
