@@ -200,10 +200,29 @@ bool word_then(std::string_view t, size_t from, size_t last, std::string_view w,
 constexpr const char* kDebugModifiers =
     " (OpenSCAD's debug modifiers # % * ! have no use here: delete it, or comment the statement out)";
 
-// A hint for OpenSCAD's syntax near a syntax error at `off`: a line that starts with
+// A hint for OpenSCAD's (or GLSL's) syntax near a syntax error at `off`: a compound or
+// component assignment, ++ and --, a line that starts with
 // `include <` or `use <`, `each`, `import(`, a hex number, a debug modifier where a statement
 // or a modifier's target starts, a `let (...)` expression.
 std::string openscad_hint(std::string_view t, size_t off) {
+    // GLSL's and C's: d += 2, d++, q.x = ... (an assignment sets a whole variable)
+    if (off < t.size() && off > 0 && t[off] == '=' && (off + 1 >= t.size() || t[off + 1] != '=')) {
+        const char op = t[off - 1];
+        if (op == '+' || op == '-' || op == '*' || op == '/' || op == '%') {
+            size_t e = off - 1;
+            while (e > 0 && (t[e - 1] == ' ' || t[e - 1] == '\t')) --e;
+            size_t b = e;
+            while (b > 0 && name_char(t[b - 1])) --b;
+            const std::string_view name = b < e ? t.substr(b, e - b) : std::string_view("x");
+            return fmt::format(" (sdfc has no compound assignment: write `{0} = {0} {1} ...;`)", name, op);
+        }
+        size_t e = previous_token_end(t, off), b = e;
+        while (b > 0 && name_char(t[b - 1])) --b;
+        if (b > 1 && b < e && t[b - 1] == '.' && name_char(t[b - 2]))
+            return " (a vector's components cannot be assigned one by one: give the whole vector, `q = [abs(q.x), q.y, q.z];`)";
+    }
+    if (off < t.size() && off > 0 && (t[off] == '+' || t[off] == '-') && t[off - 1] == t[off])
+        return fmt::format(" (sdfc has no {0}{0}: write `i = i {0} 1;`)", t[off]);
     size_t start = off < t.size() ? off : previous_token_end(t, off);  // (the error may be at the end of the file)
     while (start > 0 && t[start - 1] != '\n') --start;
     while (start < t.size() && (t[start] == ' ' || t[start] == '\t')) ++start;
