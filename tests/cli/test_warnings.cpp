@@ -66,6 +66,12 @@ TEST_CASE("warnings for one-operand CSG, an empty difference and an ignored alph
                        "smooth_difference(0.1) { box(1); }\n^\n" +
                        s + ":4:7: warning: color's alpha (the 4th component) is ignored: for see-through, material(transparency = ...)\n"
                            "color([1, 0, 0, 0.5]) sphere(1);\n      ^\n");
+    // OpenSCAD's color(c, alpha): taken, the alpha ignored with a warning (not at alpha = 1).
+    const std::string alpha = test::write_temp("warn_alpha.sdf", "color(\"red\", 0.5) sphere(1);\ncolor(\"red\", alpha = 1) box(1);\n");
+    auto a = run_sdfc("check " + q(alpha));
+    CHECK(a.status == 0);
+    CHECK(a.err == alpha + ":1:14: warning: color's alpha is ignored: for see-through, material(transparency = ...)\n"
+                           "color(\"red\", 0.5) sphere(1);\n             ^\n");
     // Once for an animation, not once per frame.
     auto frames = run_sdfc("render " + q(s) + " -o " + q(test::temp_dir() + "/warn_{frame}.png") + " --frames 0:2 --width 8 --height 8 -q");
     CHECK(frames.status == 0);

@@ -54,6 +54,23 @@ TEST_CASE("len counts a list's, a vector's, a range's elements and a string's ch
                         1, 2, 0), -0.5));
 }
 
+TEST_CASE("concat, lookup and norm, as OpenSCAD's") {
+    CHECK(close(dist_of("let a = concat([1, 2], [3], 4); sphere(len(a) + a[3]);", 0, 0, 0), -8));
+    CHECK(close(dist_of("let v = concat([1], 2); translate(concat(v, 0)) sphere(0.5);", 1, 2, 0), -0.5));  // 3 numbers: a vector
+    CHECK(close(dist_of("let pts = concat([[0, 0]], [[2, 0], [1, 2]]); sphere(len(pts));", 0, 0, 0), -3));
+    const char* table = "let t = [[0, 1], [2, 5], [1, 3]];\n";  // (any order)
+    CHECK(close(dist_of(std::string(table) + "sphere(lookup(1.5, t));", 0, 0, 0), -4));
+    CHECK(close(dist_of(std::string(table) + "sphere(lookup(-3, t));", 0, 0, 0), -1));
+    CHECK(close(dist_of(std::string(table) + "sphere(lookup(9, t));", 0, 0, 0), -5));
+    // A key that varies with the point: the radius grows with y.
+    const std::string f = "field (p) -> length(p) - lookup(p.y, [[-1, 0.5], [1, 1.5]]);";
+    CHECK(close(dist_of(f, 0, 0, 0), -1));
+    CHECK(close(dist_of(f, 0, 0.5, 0), -0.75));
+    CHECK(close(dist_of("sphere(norm([0, 3, 4]));", 0, 0, 0), -5));
+    CHECK(test::first_error_line("sphere(lookup(1, 2));") == "test.sdf:1:18: error: lookup's table is a list of [key, value] pairs, not a number");
+    CHECK(test::first_error_line("sphere(lookup(1, []));") == "test.sdf:1:18: error: lookup's table is empty");
+}
+
 TEST_CASE("if/else at statement level and ?: in expressions") {
     CHECK(close(dist_of("let r = 0.5; if (r > 0.3) sphere(r); else box(r);", 0, 0, 1), 0.5));
     CHECK(close(dist_of("let r = 0.2; if (r > 0.3) sphere(r); else box(r);", 0, 0, 1), 0.9));
