@@ -123,18 +123,7 @@ std::string view_problem(const CompiledScene& cs) {
     // (unbounded: a repeat, a custom field, a floor the camera is under)
     if (!b.finite() || !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) return inside();
     if (glm::all(glm::greaterThanEqual(c, b.lo)) && glm::all(glm::lessThanEqual(c, b.hi))) return inside();
-    if (cam.orthographic) return "";
-    const glm::vec3 f = glm::normalize(cam.target - c), r = glm::normalize(glm::cross(f, cam.up)), u = glm::cross(r, f);
-    const float th = std::tan(glm::radians(cam.fov) * 0.5f), tw = th * float(cs.render.width) / float(std::max(cs.render.height, 1));
-    // Out of view when every corner is outside one side of the view's pyramid.
-    bool out[5] = {true, true, true, true, true};
-    for (int k = 0; k < 8; ++k) {
-        const glm::vec3 p((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z);
-        const glm::vec3 d = p - c;
-        const float z = glm::dot(d, f), x = glm::dot(d, r), y = glm::dot(d, u);
-        out[0] &= z <= 0.0f, out[1] &= x > z * tw, out[2] &= x < -z * tw, out[3] &= y > z * th, out[4] &= y < -z * th;
-    }
-    if (out[0] || out[1] || out[2] || out[3] || out[4])
+    if (out_of_view(cam, b.lo, b.hi, float(cs.render.width) / float(std::max(cs.render.height, 1))))
         return fmt::format("nothing of the scene is in view: the camera at {}, {}, {} looks at {}, {}, {}, away from the scene's bounds "
                            "[{}, {}, {}] .. [{}, {}, {}]",
                            c.x, c.y, c.z, cam.target.x, cam.target.y, cam.target.z, b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);

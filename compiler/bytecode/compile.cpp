@@ -141,15 +141,35 @@ void make_programs(const Graph& g, NodeId distance, const std::vector<NodeId>& r
     if (shading_error) std::rethrow_exception(shading_error);
 }
 
+}  // namespace
+
+bool out_of_view(const ResolvedCamera& cam, const glm::vec3& lo, const glm::vec3& hi, float aspect) {
+    if (cam.orthographic) return false;
+    const glm::vec3 c = cam.position;
+    const glm::vec3 f = glm::normalize(cam.target - c), r = glm::normalize(glm::cross(f, cam.up)), u = glm::cross(r, f);
+    const float th = std::tan(glm::radians(cam.fov) * 0.5f), tw = th * aspect;
+    bool out[5] = {true, true, true, true, true};
+    for (int k = 0; k < 8; ++k) {
+        const glm::vec3 p((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+        const glm::vec3 d = p - c;
+        const float z = glm::dot(d, f), x = glm::dot(d, r), y = glm::dot(d, u);
+        out[0] &= z <= 0.0f, out[1] &= x > z * tw, out[2] &= x < -z * tw, out[3] &= y > z * th, out[4] &= y < -z * th;
+    }
+    return out[0] || out[1] || out[2] || out[3] || out[4];
+}
+
+namespace {
+
 // A script without camera() whose scene holds the default camera's place (a model in
-// millimetres, as OpenSCAD's are, around a camera at [0, 0, 5]) is seen from outside
-// instead: from the front, right and above (as OpenSCAD's first view), from where its
+// millimetres, as OpenSCAD's are, around a camera at [0, 0, 5]) or lies wholly out of its
+// view is seen from outside instead: from the front, right and above (as OpenSCAD's first view), from where its
 // bounding sphere fills the vertical field of view. Elsewhere the default stays (LANGUAGE.md section 8).
 void frame_default_camera(CompiledScene& cs) {
     const Bounds& b = cs.bounds.finite() ? cs.bounds : cs.solid_bounds;
     if (!b.finite() || !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) return;
     ResolvedCamera& cam = cs.camera;
-    if (!glm::all(glm::greaterThanEqual(cam.position, b.lo)) || !glm::all(glm::lessThanEqual(cam.position, b.hi))) return;
+    const bool inside = glm::all(glm::greaterThanEqual(cam.position, b.lo)) && glm::all(glm::lessThanEqual(cam.position, b.hi));
+    if (!inside && !out_of_view(cam, b.lo, b.hi, float(std::max(cs.render.width, 1)) / float(std::max(cs.render.height, 1)))) return;
     const glm::vec3 centre = 0.5f * (b.lo + b.hi);
     const float radius = 0.5f * glm::length(b.hi - b.lo);
     const float dist = 1.05f * radius / std::sin(glm::radians(cam.fov) * 0.5f);

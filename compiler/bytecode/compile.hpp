@@ -63,6 +63,10 @@ struct CompiledScene {
 // the view), or "" when nothing is; compile_scene and the command line's camera flags.
 std::string camera_problem(const ResolvedCamera& cam);
 
+// Whether the box [lo, hi] lies wholly outside a perspective camera's view (every corner
+// beyond one side of its pyramid) for a picture of that aspect (width / height).
+bool out_of_view(const ResolvedCamera& cam, const glm::vec3& lo, const glm::vec3& hi, float aspect);
+
 // Throws CompileError (at the setting's location) if a setting is not a constant.
 CompiledScene compile_scene(const Scene& scene);
 

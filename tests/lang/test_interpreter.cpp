@@ -187,7 +187,7 @@ TEST_CASE("scene settings are read") {
     CHECK(s.render.max_bounces == 1);
 }
 
-TEST_CASE("without camera(), a scene around the default camera is seen from outside, framed") {
+TEST_CASE("without camera(), a scene around the default camera or out of its view is framed") {
     // A model in millimetres (as OpenSCAD's): the default camera at [0, 0, 5] is inside it.
     auto compiled = test::compile_text("translate([0, 10, 0]) box(40);");
     const CompiledScene& big = compiled->cs;
@@ -197,6 +197,10 @@ TEST_CASE("without camera(), a scene around the default camera is seen from outs
     CHECK(dist == Approx(1.05f * 20.0f * std::sqrt(3.0f) / std::sin(glm::radians(22.5f))).epsilon(0.01));
     CHECK(big.camera.position.z > 20.0f);  // outside the box, in front of it
     CHECK(test::dist(big, big.camera.position.x, big.camera.position.y, big.camera.position.z) > 0.0f);
+    // A scene wholly out of the default view is framed too.
+    auto behind = test::compile_text("translate([0, 0, 500]) sphere(1);");
+    CHECK(behind->cs.camera.target.z == Approx(500.0f));
+    CHECK(glm::length(behind->cs.camera.position - glm::vec3(0, 0, 500)) < 10.0f);
     // Elsewhere, and with a camera(), the camera stays where it was put.
     CHECK(test::compile_text("sphere(1);")->cs.camera.position == glm::vec3(0, 0, 5));
     CHECK(test::compile_text("camera(position = [0, 0, 5]); box(40);")->cs.camera.position == glm::vec3(0, 0, 5));
