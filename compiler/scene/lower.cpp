@@ -97,7 +97,8 @@ Bounds shape_bounds(const Graph& g, const Shape& s) {
 
 namespace {
 
-// clip_regions of a shape placed by a rigid motion: world = r * local + t.
+// clip_regions of a shape placed by a similarity: world = r * local + t, r a rotation times
+// a uniform scale.
 bool clip_placed(const Graph& g, const Shape& s, const glm::mat3& r, const glm::vec3& t, Bounds& box,
                  std::vector<glm::vec4>& half_spaces) {
     check_stack(s.loc);
@@ -123,15 +124,23 @@ bool clip_placed(const Graph& g, const Shape& s, const glm::mat3& r, const glm::
             const glm::mat3 m = rotation_rows([&](size_t k) { return g.const_value(s.params.at(RotateP::m + k)); });
             return clip_placed(g, *s.children[0], r * m, t, box, half_spaces);
         }
+        case ShapeKind::Scale: {  // uniform only: a plane stays a plane (scale(25.4) { ...; plane(); })
+            if (!constant() || s.children.empty()) break;
+            const Vec3N v = P3(s, ScaleP::s);
+            const float k = g.const_value(v[0]);
+            if (!(k > 0.0f) || !std::isfinite(k) || g.const_value(v[1]) != k || g.const_value(v[2]) != k) break;
+            return clip_placed(g, *s.children[0], r * k, t, box, half_spaces);
+        }
         case ShapeKind::Plane: {
             if (!constant()) return false;
             const Vec3N pn = P3(s, PlaneP::normal);
             const glm::vec3 n(g.const_value(pn[0]), g.const_value(pn[1]), g.const_value(pn[2]));
             const float len = glm::length(n), h = g.const_value(P(s, PlaneP::offset));
             if (!(len > 0.0f) || !std::isfinite(len) || !std::isfinite(h)) return false;
-            // n.q <= h for q = r^T (p - t): (r n).p <= h + (r n).t
-            const glm::vec3 wn = r * (n / len);
-            const float w = h + glm::dot(wn, t);
+            // n.q <= h for q = r^-1 (p - t), r = k R: (R n).p <= k h + (R n).t
+            const float k = glm::length(r[0]);
+            const glm::vec3 wn = r * (n / len) / k;
+            const float w = k * h + glm::dot(wn, t);
             if (!std::isfinite(w)) return false;
             half_spaces.emplace_back(wn, w);
             return true;

@@ -83,6 +83,13 @@ TEST_CASE("auto box: a floor moved or turned by constants is a floor too", "[mes
     auto m = compile_text("sphere(1); translate([0, -0.6, 0]) plane();");
     REQUIRE(m->cs.half_spaces.size() == 1);
     CHECK(m->cs.half_spaces[0].w == Approx(-0.6f));
+    // A uniform scale (a model in inches: scale(25.4) { ... }) scales the floor's offset.
+    auto s = compile_text("scale(2) { sphere(0.5); translate([0, -0.3, 0]) plane(); }");
+    REQUIRE(s->cs.half_spaces.size() == 1);
+    CHECK(s->cs.half_spaces[0].y == Approx(1.0f));
+    CHECK(s->cs.half_spaces[0].w == Approx(-0.6f));
+    CHECK(box_of("scale(2) { sphere(0.5); plane(offset = -0.3); }").found);
+    CHECK(compile_text("scale([1, 2, 1]) { sphere(0.5); plane(); }")->cs.half_spaces.empty());  // not a plane's scale
 }
 
 TEST_CASE("auto box: a floor at the rest's bounds is a base at a coarse resolution too", "[mesh]") {
