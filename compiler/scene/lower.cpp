@@ -98,8 +98,8 @@ Bounds shape_bounds(const Graph& g, const Shape& s) {
 namespace {
 
 // clip_regions of a shape placed by a similarity: world = r * local + t, r a rotation times
-// a uniform scale.
-bool clip_placed(const Graph& g, const Shape& s, const glm::mat3& r, const glm::vec3& t, Bounds& box,
+// a uniform scale; every region grown by `grow` (world units: the blends around it).
+bool clip_placed(const Graph& g, const Shape& s, const glm::mat3& r, const glm::vec3& t, float grow, Bounds& box,
                  std::vector<glm::vec4>& half_spaces) {
     check_stack(s.loc);
     auto constant = [&] {
@@ -110,26 +110,36 @@ bool clip_placed(const Graph& g, const Shape& s, const glm::mat3& r, const glm::
     switch (s.kind) {
         case ShapeKind::Union:
             for (const auto& c : s.children)
-                if (!clip_placed(g, *c, r, t, box, half_spaces)) return false;
+                if (!clip_placed(g, *c, r, t, grow, box, half_spaces)) return false;
             return true;
-        case ShapeKind::Material: return s.children.empty() || clip_placed(g, *s.children[0], r, t, box, half_spaces);
+        case ShapeKind::SmoothUnion:
+        case ShapeKind::ChamferUnion:
+        case ShapeKind::StairsUnion: {  // (a blend adds at most its radius around the union: their bounds' rule)
+            if (!constant()) break;
+            const float k = g.const_value(s.params.at(0));
+            if (!(k >= 0.0f) || !std::isfinite(k)) break;
+            for (const auto& c : s.children)
+                if (!clip_placed(g, *c, r, t, grow + k * glm::length(r[0]), box, half_spaces)) return false;
+            return true;
+        }
+        case ShapeKind::Material: return s.children.empty() || clip_placed(g, *s.children[0], r, t, grow, box, half_spaces);
         case ShapeKind::Translate: {  // (a floor is often placed so: translate([0, -1, 0]) plane())
             if (!constant() || s.children.empty()) break;
             const Vec3N v = P3(s, TranslateP::v);
             const glm::vec3 d(g.const_value(v[0]), g.const_value(v[1]), g.const_value(v[2]));
-            return clip_placed(g, *s.children[0], r, t + r * d, box, half_spaces);
+            return clip_placed(g, *s.children[0], r, t + r * d, grow, box, half_spaces);
         }
         case ShapeKind::Rotate: {
             if (!constant() || s.children.empty()) break;
             const glm::mat3 m = rotation_rows([&](size_t k) { return g.const_value(s.params.at(RotateP::m + k)); });
-            return clip_placed(g, *s.children[0], r * m, t, box, half_spaces);
+            return clip_placed(g, *s.children[0], r * m, t, grow, box, half_spaces);
         }
         case ShapeKind::Scale: {  // uniform only: a plane stays a plane (scale(25.4) { ...; plane(); })
             if (!constant() || s.children.empty()) break;
             const Vec3N v = P3(s, ScaleP::s);
             const float k = g.const_value(v[0]);
             if (!(k > 0.0f) || !std::isfinite(k) || g.const_value(v[1]) != k || g.const_value(v[2]) != k) break;
-            return clip_placed(g, *s.children[0], r * k, t, box, half_spaces);
+            return clip_placed(g, *s.children[0], r * k, t, grow, box, half_spaces);
         }
         case ShapeKind::Plane: {
             if (!constant()) return false;
@@ -140,7 +150,7 @@ bool clip_placed(const Graph& g, const Shape& s, const glm::mat3& r, const glm::
             // n.q <= h for q = r^-1 (p - t), r = k R: (R n).p <= k h + (R n).t
             const float k = glm::length(r[0]);
             const glm::vec3 wn = r * (n / len) / k;
-            const float w = k * h + glm::dot(wn, t);
+            const float w = k * h + glm::dot(wn, t) + grow;
             if (!std::isfinite(w)) return false;
             half_spaces.emplace_back(wn, w);
             return true;
@@ -150,14 +160,14 @@ bool clip_placed(const Graph& g, const Shape& s, const glm::mat3& r, const glm::
     const Bounds b = shape_bounds(g, s);
     if (is_empty(b)) return true;
     if (!b.finite()) return false;
-    box = join(box, mapped_box(b, r, t));
+    box = join(box, ::sdfc::grow(mapped_box(b, r, t), grow));
     return true;
 }
 
 }  // namespace
 
 bool clip_regions(const Graph& g, const Shape& s, Bounds& box, std::vector<glm::vec4>& half_spaces) {
-    return clip_placed(g, s, glm::mat3(1.0f), glm::vec3(0.0f), box, half_spaces);
+    return clip_placed(g, s, glm::mat3(1.0f), glm::vec3(0.0f), 0.0f, box, half_spaces);
 }
 
 }  // namespace sdfc

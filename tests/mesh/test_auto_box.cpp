@@ -90,6 +90,13 @@ TEST_CASE("auto box: a floor moved or turned by constants is a floor too", "[mes
     CHECK(s->cs.half_spaces[0].w == Approx(-0.6f));
     CHECK(box_of("scale(2) { sphere(0.5); plane(offset = -0.3); }").found);
     CHECK(compile_text("scale([1, 2, 1]) { sphere(0.5); plane(); }")->cs.half_spaces.empty());  // not a plane's scale
+    // A floor blended into the rest: the half-space and the box grown by the blend's radius.
+    auto b = compile_text("smooth_union(0.3) { sphere(1); plane(offset = -1.2); }");
+    REQUIRE(b->cs.half_spaces.size() == 1);
+    CHECK(b->cs.half_spaces[0].w == Approx(-0.9f));
+    const Box blended = box_of("smooth_union(0.3) { sphere(1); plane(offset = -1.2); }");
+    REQUIRE(blended.found);
+    CHECK(blended.hi.x >= 1.3f);
 }
 
 TEST_CASE("auto box: a floor at the rest's bounds is a base at a coarse resolution too", "[mesh]") {
