@@ -78,6 +78,14 @@ struct BuiltinInfo {
 };
 
 const BuiltinInfo* find_builtin(std::string_view name);
+// Whether a script may define the name itself: the built-ins LANGUAGE.md does not name
+// (sdfc's later additions: len, concat, ...), so that a script written against the contract
+// with its own `def norm(v) = ...` keeps working; its definition wins where it is seen.
+inline bool redefinable_builtin(std::string_view name) {
+    for (std::string_view n : {"param", "len", "concat", "lookup", "norm"})
+        if (n == name) return true;
+    return false;
+}
 // The function value of a builtin (one, shared: Callable is immutable).
 const std::shared_ptr<const Callable>& builtin_callable(Builtin id);
 const BuiltinInfo& builtin_info(Builtin id);

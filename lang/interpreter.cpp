@@ -300,7 +300,7 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             if (s.kind == ast::StmtKind::Var && !env->field_scope)
                 fail(s.loc, "'var' is only allowed inside a field block; use 'let' (outside a field block a value never changes)");
             // Built-in functions keep their names; the constants (pi, tau, e, time) may be shadowed.
-            if (find_builtin(s.name))
+            if (find_builtin(s.name) && !redefinable_builtin(s.name))
                 fail(s.name_loc, fmt::format("'{}' is a built-in name and cannot be redefined", s.name));
             auto it = env->vars.find(s.name);
             if (it != env->vars.end())
@@ -347,7 +347,7 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             return;
         }
         case ast::StmtKind::Def: {
-            if (find_builtin(s.name))
+            if (find_builtin(s.name) && !redefinable_builtin(s.name))
                 fail(s.name_loc, fmt::format("'{}' is a built-in name and cannot be redefined", s.name));
             auto it = env->vars.find(s.name);
             if (it != env->vars.end())

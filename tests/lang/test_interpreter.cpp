@@ -71,6 +71,13 @@ TEST_CASE("concat, lookup and norm, as OpenSCAD's") {
     CHECK(test::first_error_line("sphere(lookup(1, []));") == "test.sdf:1:18: error: lookup's table is empty");
 }
 
+TEST_CASE("a script's own len, norm, concat, lookup or param (names the contract does not reserve) wins") {
+    CHECK(close(dist_of("let len = 3; sphere(len);", 0, 0, 0), -3));
+    CHECK(close(dist_of("def norm(v) = abs(v[0]) + abs(v[1]); sphere(norm([3, 4]));", 0, 0, 0), -7));
+    CHECK(close(dist_of("def concat(a, b) = a + b; sphere(concat(1, 2));", 0, 0, 0), -3));
+    CHECK(test::first_error_line("let sin = 2; sphere(sin);") == "test.sdf:1:5: error: 'sin' is a built-in name and cannot be redefined");
+}
+
 TEST_CASE("if/else at statement level and ?: in expressions") {
     CHECK(close(dist_of("let r = 0.5; if (r > 0.3) sphere(r); else box(r);", 0, 0, 1), 0.5));
     CHECK(close(dist_of("let r = 0.2; if (r > 0.3) sphere(r); else box(r);", 0, 0, 1), 0.9));
