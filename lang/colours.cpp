@@ -2,6 +2,7 @@
 // colour (material's, light's, ambient's, background's color).
 #include <cmath>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <fmt/format.h>
@@ -20,6 +21,12 @@ Value Interp::colour_name(const std::string& name, Loc loc) {
         const std::string near = nearest_name(name, names);
         fail(loc, near.empty() ? fmt::format("unknown colour {:?} (a CSS name such as \"tomato\", or \"#rrggbb\")", name)
                                : fmt::format("unknown colour {:?} (did you mean \"{}\"?)", name, near));
+    }
+    // "#rgba" and "#rrggbbaa" (CSS's): the alpha is not a colour's, as color([r, g, b, a])'s.
+    if (name.size() == 5 || name.size() == 9) {
+        const std::string_view a = std::string_view(name).substr(name.size() == 5 ? 4 : 7);
+        if (name[0] == '#' && a != "f" && a != "F" && a != "ff" && a != "FF" && a != "fF" && a != "Ff")
+            warn(loc, "the colour's alpha is ignored: for see-through, material(transparency = ...)");
     }
     // sRGB bytes, made linear like every colour of a scene.
     NodeId c[3];

@@ -49,6 +49,7 @@ void Interp::fail(Loc loc, std::string msg) { throw CompileError(loc, std::move(
 std::string Interp::describe(const Value& v) {
     if (v.t == VT::Vector) return fmt::format("a {}-component vector", v.n);
     if (v.t == VT::None) return "nothing";
+    if (v.t == VT::List && v.list) return fmt::format("a list of {}", v.list->size());
     std::string n = type_name(v.t);
     bool vowel = n[0] == 'a' || n[0] == 'o';
     return (vowel ? "an " : "a ") + n;
@@ -106,7 +107,8 @@ void Interp::count_calls(size_t n, Loc loc) {
 
 ShapePtr Interp::make_shape(Shape s) {
     if (++shape_count > opts.limits.max_shapes)
-        fail(s.loc, fmt::format("the scene has more than {} shapes (raise it with --max-shapes)", opts.limits.max_shapes));
+        fail(s.loc, fmt::format("the scene has more than {} shape{} (raise it with --max-shapes)", opts.limits.max_shapes,
+                                opts.limits.max_shapes == 1 ? "" : "s"));
     for (const auto& c : s.children) {
         s.depth = std::max(s.depth, c->depth + 1);
         s.tree_size += std::min(c->tree_size, opts.limits.max_shapes + 1);
@@ -114,9 +116,9 @@ ShapePtr Interp::make_shape(Shape s) {
     // A shape used twice is lowered twice: count the tree as lowering walks it, so that
     // sharing (`let b = union { a; a; }; let c = union { b; b; }; ...`) cannot blow up.
     if (s.tree_size > opts.limits.max_shapes)
-        fail(s.loc, fmt::format("the scene has more than {} shapes, counting a shared shape at each use "
+        fail(s.loc, fmt::format("the scene has more than {} shape{}, counting a shared shape at each use "
                                 "(raise it with --max-shapes)",
-                                opts.limits.max_shapes));
+                                opts.limits.max_shapes, opts.limits.max_shapes == 1 ? "" : "s"));
     if (s.depth > opts.limits.max_shape_depth)
         fail(s.loc, fmt::format("shapes nested more than {} deep (raise it with --max-shape-depth)", opts.limits.max_shape_depth));
     return std::make_shared<const Shape>(std::move(s));
@@ -181,6 +183,8 @@ Scene Interp::run(const SourceFile& file) {
             if (names && !top->vars.count(st->name)) failed_lets.insert(st->name);
             failed_import |= st->kind == ast::StmtKind::Import;
             if (errors.size() >= 20) break;
+            // A limit is the whole script's: the statements after would each repeat it.
+            if (!e.diagnostics().empty() && e.diagnostics().back().message.find("(raise it with --max-") != std::string::npos) break;
         }
     }
     if (!errors.empty()) throw CompileError(std::move(errors));

@@ -71,6 +71,11 @@ TEST_CASE("flag --max-shapes and --max-shape-depth") {
     CHECK(st == 1);
     CHECK(err == s + ":1:42: error: the scene has more than 100 shapes (raise it with --max-shapes)");
     CHECK(check(s, "--max-shapes 1000").first == 0);
+    // Once, though later statements make shapes too; "1 shape".
+    const std::string two = test::write_temp("lim_shapes_two.sdf", "sphere(1);\nbox(1);\ntranslate([2, 0, 0]) box(1);\n");
+    auto once = run_sdfc("check '" + two + "' --max-shapes 1");
+    CHECK(once.status == 1);
+    CHECK(once.err == two + ":2:1: error: the scene has more than 1 shape (raise it with --max-shapes)\nbox(1);\n^\n");
     std::string d = test::write_temp("lim_depth.sdf", "def f(n) = n > 0 ? translate([0, 0.1, 0]) f(n - 1) : sphere(1);\nf(30);\n");
     CHECK(check(d, "--max-shape-depth 10") ==
           std::pair<int, std::string>{1, d + ":1:20: error: shapes nested more than 10 deep (raise it with --max-shape-depth)"});

@@ -72,6 +72,9 @@ TEST_CASE("warnings for one-operand CSG, an empty difference and an ignored alph
     CHECK(a.status == 0);
     CHECK(a.err == alpha + ":1:14: warning: color's alpha is ignored: for see-through, material(transparency = ...)\n"
                            "color(\"red\", 0.5) sphere(1);\n             ^\n");
+    const std::string hex = test::write_temp("warn_hex_alpha.sdf", "color(\"#ff000080\") sphere(1);\ncolor(\"#f00f\") box(1);\n");
+    CHECK(run_sdfc("check " + q(hex)).err == hex + ":1:7: warning: the colour's alpha is ignored: for see-through, material(transparency = ...)\n"
+                                              "color(\"#ff000080\") sphere(1);\n      ^\n");
     // Once for an animation, not once per frame.
     auto frames = run_sdfc("render " + q(s) + " -o " + q(test::temp_dir() + "/warn_{frame}.png") + " --frames 0:2 --width 8 --height 8 -q");
     CHECK(frames.status == 0);

@@ -125,6 +125,10 @@ TEST_CASE("a def or an assignment that failed is reported once, not again as an 
     CHECK(e.find("unknown name 'x'") == std::string::npos);
 }
 
+TEST_CASE("a list's size is named where it is wrong") {
+    CHECK(first_error_line("polygon([[0, 0], [1, 0]]);") == "test.sdf:1:9: error: polygon takes a list of 3 or more points [x, y], not a list of 2");
+}
+
 TEST_CASE("var is for field blocks, let cannot be reassigned") {
     CHECK(first_error_line("var x = 1;") == "test.sdf:1:1: error: 'var' is only allowed inside a field block; use 'let' (outside a field block a value never changes)");
     CHECK(first_error_line("field (p) -> { let d = 1; d = 2; d };") ==
