@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <csignal>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -654,6 +655,8 @@ int main(int argc, char** argv) {
     int rc = 1;
     const size_t stack = std::min(sdfc::max_thread_stack(), size_t(1) << 30);
     sdfc::install_temp_cleanup();
+    // A closed pipe is a write error to report (exit 1), not a signal that kills silently.
+    ::signal(SIGPIPE, SIG_IGN);
     auto work = [&] {
         sdfc::cli::use_big_pages();  // (the heap of the thread that parses and compiles)
         rc = finish_stdout(run(argc, argv));

@@ -76,3 +76,16 @@ TEST_CASE("the output path - needs a format, and --format needs it") {
     CHECK(WEXITSTATUS(st) == 1);
     CHECK(test::slurp(err) == "sdfc: error: cannot write to standard output: No space left on device\n");
 }
+
+TEST_CASE("a pipe closed before the output is written is a write error (exit 1), not a silent SIGPIPE") {
+    const char* bin = std::getenv("SDFC_BIN");
+    const std::string exe = bin ? bin : SDFC_BIN_PATH;
+    const std::string err = test::temp_dir() + "/sigpipe_err.txt";
+    // (the shader of a big example is well over a pipe's buffer)
+    const std::string cmd = "bash -c \"'" + exe + "' glsl '" + test::example("showcase.sdf") + "' 2>'" + err +
+                            "' | head -c 10 >/dev/null; exit \\${PIPESTATUS[0]}\"";
+    const int st = std::system(cmd.c_str());
+    REQUIRE(WIFEXITED(st));
+    CHECK(WEXITSTATUS(st) == 1);
+    CHECK(test::slurp(err) == "sdfc: error: cannot write to standard output: Broken pipe\n");
+}
