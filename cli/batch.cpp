@@ -77,6 +77,29 @@ std::optional<std::pair<int, int>> read_bands(const std::optional<std::string>& 
     return index_of_count("--tiles", *flag);
 }
 
+std::string picture_id(const CompiledScene& cs, const RenderOptions& ro) {
+    uint64_t h = 1469598103934665603ull;  // FNV-1a
+    auto bytes = [&](const void* p, size_t n) {
+        for (size_t i = 0; i < n; ++i) h = (h ^ static_cast<const unsigned char*>(p)[i]) * 1099511628211ull;
+    };
+    auto value = [&](const auto& v) { bytes(&v, sizeof v); };
+    for (const Program* p : {&cs.distance, &cs.shading}) {
+        bytes(p->code.data(), p->code.size() * sizeof(Instr));
+        bytes(p->outputs.data(), p->outputs.size() * sizeof(p->outputs[0]));
+    }
+    value(cs.camera.position), value(cs.camera.target), value(cs.camera.up), value(cs.camera.fov), value(cs.camera.orthographic);
+    value(cs.camera.ortho_height);
+    for (const ResolvedLight& l : cs.lights) value(l.position), value(l.direction), value(l.color), value(l.intensity), value(l.radius);
+    value(cs.ambient), value(cs.background), value(cs.time);
+    const RenderSettings& r = cs.render;
+    value(r.width), value(r.height), value(r.samples), value(r.max_steps), value(r.max_bounces), value(r.max_distance), value(r.epsilon);
+    value(r.shadows), value(r.ao), value(r.exposure);
+    bytes(r.aa.data(), r.aa.size()), bytes(r.tonemap.data(), r.tonemap.size());
+    value(ro.alpha), value(ro.view), value(ro.bands), value(ro.baseline);
+    for (const std::string& a : ro.aovs) bytes(a.data(), a.size() + 1);
+    return fmt::format("{:016x}", h);
+}
+
 int cmd_merge(Args& a) {
     auto out = a.value("-o", "--output");
     auto format = a.value("--format");
@@ -114,6 +137,9 @@ int cmd_merge(Args& a) {
         if (b.width != img.width || b.full_height != img.height || b.channels != img.channels || b.aovs.size() != img.aovs.size())
             throw std::runtime_error(fmt::format("'{}' is a band of another picture ({}x{}, {} channels) than '{}' ({}x{}, {} channels)", name,
                                                  b.width, b.full_height, b.channels, parts[order[0]], img.width, img.height, img.channels));
+        if (b.picture != first.picture)
+            throw std::runtime_error(fmt::format("'{}' is a band of another picture than '{}' (another scene, frame or setting)", name,
+                                                 parts[order[0]]));
         if (b.row0 != next)
             throw std::runtime_error(b.row0 > next ? fmt::format("rows {} to {} are in none of the bands", next, b.row0 - 1)
                                                    : fmt::format("'{}' overlaps another band (rows {} to {})", name, b.row0, next - 1));

@@ -11,6 +11,7 @@
 #include "compiler/base/source.hpp"
 #include "compiler/bytecode/compile.hpp"
 #include "lang/interpreter.hpp"
+#include "runtime/cpu/tracer.hpp"
 
 namespace sdfc::cli {
 
@@ -73,6 +74,9 @@ struct Shard {
 Shard read_shard(const std::optional<std::string>& flag, size_t items);
 // --tiles I/N: band I of N, or nothing.
 std::optional<std::pair<int, int>> read_bands(const std::optional<std::string>& flag);
+// What a band's picture is (batch.cpp): a hash of the compiled scene, its settings and the
+// render's options, that sdfc merge compares.
+std::string picture_id(const CompiledScene& cs, const RenderOptions& ro);
 int cmd_merge(Args& a);
 
 // The scene flags a command took out of its arguments (flag, value if given): they override

@@ -343,6 +343,7 @@ int cmd_render(Args& a) {
             }
             double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
             if (bar) std::fputs("\r\033[K", stderr), bar = false;
+            if (bands) img.picture = picture_id(cs, ro);
             write_image(target, img, WriteOptions{true, fmt_ext});
             ++done;
             if (!quiet)

@@ -30,6 +30,9 @@ struct Image {
     // A band of a taller picture (sdfc render --tiles): its first row there, and that
     // picture's height; 0 and 0 for a whole picture. Written as an EXR data window.
     int row0 = 0, full_height = 0;
+    // A band's picture (a hash of what was rendered; EXR attribute sdfc:picture): sdfc merge
+    // joins only bands of one picture. Empty: unknown.
+    std::string picture;
     std::vector<float> pixels;  // linear RGB (channels interleaved), row-major, row 0 at the top
     std::vector<AovPlane> aovs;
 

@@ -152,6 +152,13 @@ TEST_CASE("render --tiles bands and sdfc merge make the one-render picture, byte
     auto nine = run_sdfc("render " + q(s) + size + " --tiles 0/9 -o " + q(dir + "/p.exr"));
     CHECK(nine.status == 2);  // (the command line asks what the picture cannot give)
     CHECK(nine.err == "sdfc: error: band 0 of 9: the picture has 5 rows of tiles (16 pixels each)\n");
+    // A band of another scene, or of another frame, of the same size is another picture's.
+    const std::string other = test::write_temp("tiles_other.sdf", "camera(position = [0, 1, 5]);\nsphere(1);\nplane();\n");
+    REQUIRE(run_sdfc("render " + q(other) + size + " --aov depth,normal --tiles 1/3 --alpha on -o " + q(dir + "/other1.exr")).status == 0);
+    auto mixed = run_sdfc("merge " + q(dir + "/part0.exr") + " " + q(dir + "/other1.exr") + " " + q(dir + "/part2.exr") + " -o " + q(dir + "/x.png"));
+    CHECK(mixed.status == 1);
+    CHECK(mixed.err == "sdfc: error: '" + dir + "/other1.exr' is a band of another picture than '" + dir +
+                           "/part0.exr' (another scene, frame or setting)\n");
     auto self = run_sdfc("merge " + q(dir + "/part0.exr") + " -o " + q(dir + "/part0.exr"));
     CHECK(self.status == 1);
     CHECK(self.err == "sdfc: error: cannot write '" + dir + "/part0.exr': it is one of the bands merged ('" + dir + "/part0.exr')\n");

@@ -102,12 +102,14 @@ void verify_file(const std::string& path, const std::string& file, int width, in
 // `row0` and `full_height` (> 0): the image is that band of a taller picture, written as
 // the EXR data window inside that picture's display window.
 void write_atomic(const std::string& path, const std::string& as, int width, int height, const std::vector<std::string>& names,
-                  OIIO::TypeDesc type, const void* data, bool linear, int row0 = 0, int full_height = 0) {
+                  OIIO::TypeDesc type, const void* data, bool linear, int row0 = 0, int full_height = 0,
+                  const std::string& picture = "") {
     if (width <= 0 || height <= 0) throw std::runtime_error(write_error(path, "the image is empty"));
     OIIO::ImageSpec spec(width, height, static_cast<int>(names.size()), type);
     if (full_height > 0) {
         spec.y = row0;
         spec.full_x = 0, spec.full_y = 0, spec.full_width = width, spec.full_height = full_height;
+        if (!picture.empty()) spec.attribute("sdfc:picture", picture);
     }
     spec.channelnames = names;
     spec.alpha_channel = -1;
@@ -257,7 +259,7 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
             for (const AovPlane* a : planes)
                 for (int c = 0; c < a->channels; ++c) o[k++] = stored(*a, a->data[i * a->channels + c]);
         }
-        write_atomic(path, as, img.width, img.height, names, OIIO::TypeDesc::FLOAT, buf.data(), true, img.row0, img.full_height);
+        write_atomic(path, as, img.width, img.height, names, OIIO::TypeDesc::FLOAT, buf.data(), true, img.row0, img.full_height, img.picture);
         return;
     }
     if (img.full_height > 0)
@@ -345,7 +347,7 @@ Image oiio_read_image(const std::string& path) {
     }
     const size_t n = static_cast<size_t>(w) * h;
     Image img(w, h, std::max<int>(1, static_cast<int>(colour.size())));
-    if (band) img.row0 = spec.y, img.full_height = spec.full_height;
+    if (band) img.row0 = spec.y, img.full_height = spec.full_height, img.picture = spec.get_string_attribute("sdfc:picture");
     for (size_t i = 0; i < n; ++i)
         for (size_t k = 0; k < colour.size(); ++k) {
             float v = buf[i * nch + colour[k]];
