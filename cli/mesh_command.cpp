@@ -118,6 +118,8 @@ int cmd_mesh(Args& a) {
         mo.lo = {f[0], f[1], f[2]}, mo.hi = {f[3], f[4], f[5]};
         if (!(mo.lo.x < mo.hi.x && mo.lo.y < mo.hi.y && mo.lo.z < mo.hi.z))
             throw UsageError("--bounds needs X0 < X1, Y0 < Y1 and Z0 < Z1");
+        for (float v : f)  // (as the camera: beyond, a float cannot place a vertex within a cell)
+            if (!(std::fabs(v) <= 1e15f)) throw UsageError("--bounds must lie within 1e15 of the origin on each axis");
     } else if (!mesh::default_box(cs, mo.lo, mo.hi, t, 8192, mo.resolution)) {
         const auto& code = cs.distance.code;
         const bool reads_point = std::any_of(code.begin(), code.end(), [](const Instr& in) {

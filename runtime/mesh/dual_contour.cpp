@@ -57,6 +57,7 @@ void vertex_box(const Grid& g, glm::ivec3 cell, glm::vec3& lo, glm::vec3& hi) {
         if (lo[k] > g.lo[k]) lo[k] += m;
         if (hi[k] < g.hi[k]) hi[k] -= m;
     }
+    lo = glm::max(lo, g.lo), hi = glm::min(hi, g.hi);  // (a cell may reach out of a thin box)
 }
 
 // Vertices the planes left off the surface (a cell that holds a crease but not the corner

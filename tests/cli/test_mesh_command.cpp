@@ -56,6 +56,8 @@ TEST_CASE("mesh errors come before the work and change nothing") {
           "sdfc: error: --resolution and --cell are two ways to say the same: give one\n");
     CHECK(run_sdfc("mesh " + q(s) + " -o a.stl --bounds 1,1,1,0,0,0").err ==
           "sdfc: error: --bounds needs X0 < X1, Y0 < Y1 and Z0 < Z1\n");
+    CHECK(run_sdfc("mesh " + q(s) + " -o a.stl --bounds -1e30,-1,-1,1e30,1,1").err ==
+          "sdfc: error: --bounds must lie within 1e15 of the origin on each axis\n");
     CHECK(run_sdfc("mesh " + q(s) + " -o a.stl --resolution 4000").err ==
           "sdfc: error: a grid of 64384768512 cells is over the limit of 2147483648 (raise it with --max-cells)\n");
     CHECK(run_sdfc("mesh " + q(s) + " -o a.stl --max-cells 1e12").err == "sdfc: error: --max-cells must be from 1 to 68719476736, not 1e12\n");
