@@ -103,7 +103,7 @@ std::string picture_id(const CompiledScene& cs, const RenderOptions& ro) {
 int cmd_merge(Args& a) {
     auto out = a.value("-o", "--output");
     auto format = a.value("--format");
-    const bool quiet = a.flag("--quiet") || a.flag("-q");
+    const bool quiet = a.flag("--quiet") | a.flag("-q");  // (both read: either may be given, or both)
     const std::vector<std::string> parts = a.positionals();
     if (parts.empty()) throw UsageError("merge needs the bands: sdfc merge PART.exr... -o OUT");
     if (!out) throw UsageError("merge needs -o OUT");

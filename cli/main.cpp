@@ -163,7 +163,7 @@ int cmd_render(Args& a) {
     auto aov = a.value("--aov");
     auto threads = a.value("--threads");
     auto view = a.value("--view");
-    bool quiet = a.flag("--quiet") || a.flag("-q");
+    bool quiet = a.flag("--quiet") | a.flag("-q");  // (both read: either may be given, or both)
     bool baseline = a.flag("--baseline");  // hidden: every acceleration off (issue 6)
     auto format = a.value("--format");
     auto alpha = a.value("--alpha");

@@ -74,7 +74,7 @@ int cmd_mesh(Args& a) {
     auto max_tris = a.value("--max-triangles");
     auto max_cells = a.value("--max-cells");
     auto simplify = a.value("--simplify");
-    bool quiet = a.flag("--quiet") || a.flag("-q");
+    bool quiet = a.flag("--quiet") | a.flag("-q");  // (both read: either may be given, or both)
     bool error_stats = a.flag("--error");
     auto format = a.value("--format");
     std::string path = one_scene(a, "mesh");

@@ -51,6 +51,10 @@ TEST_CASE("a bad command line exits 2 and a bad script 1, unknown options get di
     auto ok = run_sdfc("eval --at 0,0,0 -- '" + s + "'");
     CHECK(ok.status == 0);
     CHECK(ok.out == "-1\n");
+    // An option and its short form, both given.
+    auto both = run_sdfc("render '" + s + "' --quiet -q --width 8 --height 8 -o '" + test::temp_dir() + "/both.png'");
+    CHECK(both.status == 0);
+    CHECK(both.err.empty());
 }
 
 TEST_CASE("a number out of range is quoted as typed, and {name} of standard input is stdin") {
