@@ -60,8 +60,24 @@ uint32_t decode_at(std::string_view s, size_t i, size_t& len) {
 }
 }  // namespace
 
+namespace {
+
+// A message that quotes a huge name or string (a 1 MB identifier) keeps its start and end.
+std::string shortened(const std::string& m) {
+    constexpr size_t kMost = 600, kHead = 400, kTail = 150;
+    if (m.size() <= kMost) return m;
+    auto boundary = [&](size_t i) {  // back to a UTF-8 character's first byte
+        while (i > 0 && (static_cast<unsigned char>(m[i]) & 0xC0) == 0x80) --i;
+        return i;
+    };
+    const size_t head = boundary(kHead), tail = boundary(m.size() - kTail);
+    return m.substr(0, head) + " [... " + std::to_string(tail - head) + " bytes ...] " + m.substr(tail);
+}
+
+}  // namespace
+
 std::string format_diagnostic(const Diagnostic& d, const char* kind) {
-    if (!d.loc.known()) return fmt::format("sdfc: {}: {}\n", kind, d.message);
+    if (!d.loc.known()) return fmt::format("sdfc: {}: {}\n", kind, shortened(d.message));
     const SourceFile& file = *d.loc.file;
     uint32_t line = d.loc.line;
     std::string_view src = file.line(line);
@@ -83,7 +99,7 @@ std::string format_diagnostic(const Diagnostic& d, const char* kind) {
     // Columns count characters (UTF-8 code points), not bytes.
     size_t chars = 0;
     for (size_t i = 0; i < col; ++i) chars += continuation(i) ? 0 : 1;
-    std::string out = fmt::format("{}:{}:{}: {}: {}\n", file.path, line, chars + 1, kind, d.message);
+    std::string out = fmt::format("{}:{}:{}: {}: {}\n", file.path, line, chars + 1, kind, shortened(d.message));
     // A very long line (minified or generated text) is shown as a window around the column.
     constexpr size_t kWindow = 160;
     size_t b = 0, e = src.size();

@@ -125,6 +125,14 @@ TEST_CASE("a def or an assignment that failed is reported once, not again as an 
     CHECK(e.find("unknown name 'x'") == std::string::npos);
 }
 
+TEST_CASE("a message that quotes a huge name keeps its start and end") {
+    const std::string e = first_error_line("sphere(" + std::string(100000, 'a') + ");");
+    CHECK(e.size() < 700);
+    CHECK(e.rfind("test.sdf:1:8: error: unknown name 'aaaa", 0) == 0);
+    CHECK(e.find(" bytes ...] ") != std::string::npos);
+    CHECK(e.substr(e.size() - 5) == "aaaa'");
+}
+
 TEST_CASE("a list's size is named where it is wrong") {
     CHECK(first_error_line("polygon([[0, 0], [1, 0]]);") == "test.sdf:1:9: error: polygon takes a list of 3 or more points [x, y], not a list of 2");
 }
