@@ -412,6 +412,7 @@ int cmd_eval(Args& a) {
     std::string path = one_scene(a, "eval");
     if (!at && !points) throw UsageError("eval needs --at X,Y,Z or --points FILE");
     if (at && points) throw UsageError("eval takes --at X,Y,Z or --points FILE, not both");
+    if (points && *points == "-" && path == "-") throw UsageError("the scene and --points cannot both be standard input (-)");
     std::vector<float> xs, ys, zs;
     if (at) {
         auto f = Args::to_floats("--at", *at, 3);

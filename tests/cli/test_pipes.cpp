@@ -36,6 +36,17 @@ TEST_CASE("the scene path - reads the scene from standard input") {
     CHECK(fs::exists(test::temp_dir() + "/pipe_f1.png"));
 }
 
+TEST_CASE("eval --points - reads the points from standard input") {
+    const std::string s = test::write_temp("pipe_points.sdf", "sphere(1);\n");
+    auto r = run_sdfc("eval '" + s + "' --points -", "", stdin_file("pipe_points.txt", "0 0 0\n2 0 0\n"));
+    CHECK(r.status == 0);
+    CHECK(r.out == "-1\n1\n");
+    auto bad = run_sdfc("eval '" + s + "' --points -", "", stdin_file("pipe_points_bad.txt", "0 0\n"));
+    CHECK(bad.status == 1);
+    CHECK(bad.err == "<stdin>:1:4: error: expected three numbers \"x y z\"\n0 0\n   ^\n");
+    CHECK(run_sdfc("eval - --points -", "", s).err == "sdfc: error: the scene and --points cannot both be standard input (-)\n");
+}
+
 TEST_CASE("the output path - writes images, meshes and shaders to standard output") {
     const std::string s = test::write_temp("pipe_out.sdf", "sphere(1);\n");
     auto png = run_sdfc("render " + q(s) + " -o - --format png --width 16 --height 8");
