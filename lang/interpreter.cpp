@@ -383,6 +383,11 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             std::error_code ec;
             std::string key = fs::weakly_canonical(target, ec).string();
             if (ec) fail(s.loc, fmt::format("cannot open '{}': {}", target.string(), ec.message()));
+            // (each file passes on the names of those it imports: a chain costs its depth squared)
+            if (import_stack.size() >= size_t(opts.limits.max_nesting))
+                fail(s.loc, fmt::format("imports nested deeper than {} files ({})", opts.limits.max_nesting,
+                                        opts.limits.max_nesting >= ast::ParseOptions::kMostNesting ? "the most --max-nesting allows"
+                                                                                                   : "raise it with --max-nesting"));
             if (std::find(import_stack.begin(), import_stack.end(), key) != import_stack.end()) {
                 std::string chain;
                 for (const auto& p : import_stack) chain += fs::path(p).filename().string() + " -> ";

@@ -82,6 +82,19 @@ TEST_CASE("flag --max-shapes and --max-shape-depth") {
     CHECK(check(d).first == 0);
 }
 
+TEST_CASE("imports nested deeper than --max-nesting") {
+    // A chain of files, each importing the next (each passes on all the names below it): the
+    // top file and 7 more, the 8th import refused.
+    for (int i = 0; i < 12; ++i)
+        test::write_temp("lim_chain" + std::to_string(i) + ".sdf",
+                         "import \"lim_chain" + std::to_string(i + 1) + ".sdf\";\ndef f" + std::to_string(i) + "() = 1;\n");
+    test::write_temp("lim_chain12.sdf", "def z() = 1;\n");
+    const std::string top = test::write_temp("lim_chain_top.sdf", "import \"lim_chain0.sdf\";\nsphere(z());\n");
+    CHECK(check(top).first == 0);
+    CHECK(check(top, "--max-nesting 8") ==
+          std::pair<int, std::string>{1, test::temp_dir() + "/lim_chain6.sdf:1:1: error: imports nested deeper than 8 files (raise it with --max-nesting)"});
+}
+
 TEST_CASE("flag --max-ops") {
     std::string s = test::write_temp("lim_ops.sdf",
         "field (p) -> { var d = p.x; for (i = [1 : 100]) d = min(d, length(p - [i, 0, 0]) - 0.5); d };\n");
