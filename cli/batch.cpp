@@ -114,7 +114,7 @@ int cmd_merge(Args& a) {
     } else if (format) {
         throw UsageError(fmt::format("--format is for -o - (standard output); the extension of '{}' names its format", *out));
     }
-    check_image_output(*out, fmt_ext);
+    check_picture_output(*out, fmt_ext);
     for (const std::string& p : parts)
         if (std::error_code ec; std::filesystem::equivalent(*out, p, ec) && !ec)
             throw std::runtime_error(fmt::format("cannot write '{}': it is one of the bands merged ('{}')", *out, p));

@@ -252,7 +252,7 @@ int cmd_render(Args& a) {
         std::string name = scene_name(path);
         for (int f : {f0, f1}) {
             std::string target = expand(*out, f, name);
-            check_image_output(target, fmt_ext);
+            check_picture_output(target, fmt_ext);
             check_not_input(target, path);
             if (!is_exr(target) && target != "-")
                 for (const std::string& av : ro.aovs) check_image_output(aov_side_path(target, av));
@@ -460,7 +460,7 @@ int cmd_slice(Args& a) {
     if (h) so.height = Args::to_int("--height", *h, 1, 16384);
     if (double(so.width) * so.height > double(c.max_pixels))
         throw UsageError(fmt::format("{}x{} pixels is over the limit of {} (raise it with --max-pixels)", so.width, so.height, c.max_pixels));
-    check_image_output(*out, fmt_ext);
+    check_picture_output(*out, fmt_ext);
     check_not_input(*out, path);
     SourceManager sm;
     CompiledScene cs = build(sm, path, c, time_s ? Args::to_float("--time", *time_s) : 0.0f);

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "cli/args.hpp"
+#include "runtime/io/image.hpp"
 #include "runtime/eval/vm.hpp"
 
 namespace sdfc::cli {
@@ -33,6 +34,19 @@ bool same_file(const std::string& a, const std::string& b) {
 }
 
 }  // namespace
+
+void check_picture_output(const std::string& out, const std::string& format) {
+    try {
+        check_image_output(out, format);
+    } catch (const UsageError&) {
+        throw;
+    } catch (const std::runtime_error& e) {
+        if (out != "-") throw;
+        const std::string m = e.what();
+        const size_t at = m.find("': ");
+        throw UsageError(fmt::format("--format {}: {}", format, at == std::string::npos ? m : m.substr(at + 3)));
+    }
+}
 
 void check_not_input(const std::string& out, const std::string& scene) {
     if (same_file(out, scene)) throw std::runtime_error(fmt::format("cannot write '{}': it is the scene file '{}'", out, scene));

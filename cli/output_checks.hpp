@@ -14,6 +14,9 @@ bool is_exr(const std::string& path);
 
 // Throws std::runtime_error "cannot write 'OUT': ..." when `out` is the scene file, or (with
 // the SourceManager of the loaded scene) any file the scene read.
+// check_image_output, where a bad --format for standard output (-o - --format stl) is a
+// command-line error (exit 2) rather than a write to a made-up file's name.
+void check_picture_output(const std::string& out, const std::string& format);
 void check_not_input(const std::string& out, const std::string& scene);
 void check_not_input(const std::string& out, const SourceManager& sm);
 

@@ -36,6 +36,14 @@ TEST_CASE("the scene path - reads the scene from standard input") {
     CHECK(fs::exists(test::temp_dir() + "/pipe_f1.png"));
 }
 
+TEST_CASE("an unknown --format for standard output is a command-line error") {
+    const std::string s = test::write_temp("pipe_format.sdf", "sphere(1);\n");
+    auto r = run_sdfc("render '" + s + "' -o - --format stl");
+    CHECK(r.status == 2);
+    CHECK(r.err.rfind("sdfc: error: --format stl: unknown image format '.stl' (known: .png", 0) == 0);
+    CHECK(r.out.empty());
+}
+
 TEST_CASE("eval --points - reads the points from standard input") {
     const std::string s = test::write_temp("pipe_points.sdf", "sphere(1);\n");
     auto r = run_sdfc("eval '" + s + "' --points -", "", stdin_file("pipe_points.txt", "0 0 0\n2 0 0\n"));
