@@ -82,7 +82,7 @@ TEST_CASE("the output path - needs a format, and --format needs it") {
     CHECK(run_sdfc("render " + q(s) + " -o -").err == "sdfc: error: -o - (standard output) needs --format (png, jpg, exr, hdr, tif, ...)\n");
     CHECK(run_sdfc("render " + q(s) + " -o x.png --format png").err ==
           "sdfc: error: --format is for -o - (standard output); the extension of 'x.png' names its format\n");
-    CHECK(run_sdfc("render " + q(s) + " -o - --format exr2").status == 1);
+    CHECK(run_sdfc("render " + q(s) + " -o - --format exr2").status == 2);  // (as mesh's --format xyz)
     CHECK(run_sdfc("render " + q(s) + " -o - --format png --aov depth").err ==
           "sdfc: error: --aov to standard output needs --format exr (as channels: side files need a file name)\n");
     CHECK(run_sdfc("mesh " + q(s) + " -o -").err == "sdfc: error: -o - (standard output) needs --format (stl, obj, ply or 3mf)\n");
