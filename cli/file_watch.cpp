@@ -66,9 +66,11 @@ void wait_for_change(const std::map<std::string, Stamp>& files, int debounce_ms)
 }
 
 
-std::map<std::string, Stamp> files_read(const std::vector<std::string>& command) {
+std::map<std::string, Stamp> files_read(const std::vector<std::string>& command) { return files_read(command, take_loaded_paths()); }
+
+std::map<std::string, Stamp> files_read(const std::vector<std::string>& command, const std::vector<std::string>& loaded) {
     std::map<std::string, Stamp> files;
-    for (const std::string& p : take_loaded_paths()) files[p] = stamp_of(p);
+    for (const std::string& p : loaded) files[p] = stamp_of(p);
     if (files.empty())
         for (size_t k = 1; k < command.size(); ++k)
             if (fs::path(command[k]).extension() == ".sdf" || fs::path(command[k]).extension() == ".vm") files[command[k]] = stamp_of(command[k]);

@@ -22,6 +22,8 @@ Stamp stamp_of(const std::string& path);
 // The files a run read (the scene, its imports: take_loaded_paths), stamped now; when it
 // read none (its scene did not open), the .sdf and .vm arguments of `command`.
 std::map<std::string, Stamp> files_read(const std::vector<std::string>& command);
+// ... from the paths already taken.
+std::map<std::string, Stamp> files_read(const std::vector<std::string>& command, const std::vector<std::string>& loaded);
 
 // Waits until one of `files` is saved and then `debounce_ms` pass without another event.
 void wait_for_change(const std::map<std::string, Stamp>& files, int debounce_ms);

@@ -56,7 +56,11 @@ int cmd_watch(const std::vector<std::string>& args, int (*run)(const std::vector
         rc = run(command);
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         // What the run read (the scene, its imports); a scene that failed to open too.
-        const std::map<std::string, Stamp> files = files_read(command);
+        const std::vector<std::string> loaded = take_loaded_paths();
+        // A command line refused before any scene was read (a missing -o, an unknown
+        // option): no save can fix it.
+        if (rc == 2 && n == 1 && loaded.empty()) throw UsageError("watch stops: the command line above is wrong, and no save of the scene can fix it");
+        const std::map<std::string, Stamp> files = files_read(command, loaded);
         std::fprintf(stderr, "sdfc watch: run %ld %s in %.1f ms; watching %zu file%s\n", n, rc == 0 ? "ok" : "failed", ms, files.size(),
                      files.size() == 1 ? "" : "s");
         std::fflush(stdout);

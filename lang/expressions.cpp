@@ -42,7 +42,10 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
         }
         case K::Ident: {
             if (Binding* b = env->find(e.text)) return b->value;
-            if (e.text == "time") return Value::number(opts.time ? g->constant(*opts.time) : g->input(Op::Time));
+            if (e.text == "time") {
+                scene.reads_time = true;
+                return Value::number(opts.time ? g->constant(*opts.time) : g->input(Op::Time));
+            }
             if (e.text == "pi") return Value::number(g->constant(3.14159265358979f));
             if (e.text == "tau") return Value::number(g->constant(6.28318530717959f));
             if (e.text == "e") return Value::number(g->constant(2.71828182845905f));

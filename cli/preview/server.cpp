@@ -90,6 +90,12 @@ PreviewServer* start(const std::string& host, int port, const std::string& page,
     auto s = std::make_unique<PreviewServer>();
     s->shared->token = token;
     routes(s->http, s->shared, page);
+    // SO_REUSEADDR only: httplib's default, SO_REUSEPORT, lets a second preview bind the same
+    // port, and the kernel then splits the connections between the two.
+    s->http.set_socket_options([](socket_t sock) {
+        int yes = 1;
+        ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    });
     const int b = port == 0 ? s->http.bind_to_any_port(host) : (s->http.bind_to_port(host, port) ? port : -1);
     if (b < 0) {
         *error = fmt::format("cannot serve on {}:{} (in use? --port 0 takes any free port)", host, port);

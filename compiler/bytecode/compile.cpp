@@ -160,18 +160,20 @@ bool out_of_view(const ResolvedCamera& cam, const glm::vec3& lo, const glm::vec3
 
 namespace {
 
-// A script without camera() whose scene holds the default camera's place (a model in
-// millimetres, as OpenSCAD's are, around a camera at [0, 0, 5]) or lies wholly out of its
-// view is seen from outside instead: from the front, right and above (as OpenSCAD's first view), from where its
+// A script without camera() whose scene's bounding sphere holds the default camera (a model
+// in millimetres, as OpenSCAD's are, around or just before a camera at [0, 0, 5]) or lies
+// wholly out of its view is seen from outside instead: from the front, right and above (as OpenSCAD's first view), from where its
 // bounding sphere fills the vertical field of view. Elsewhere the default stays (LANGUAGE.md section 8).
 void frame_default_camera(CompiledScene& cs) {
     const Bounds& b = cs.bounds.finite() ? cs.bounds : cs.solid_bounds;
     if (!b.finite() || !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) return;
     ResolvedCamera& cam = cs.camera;
-    const bool inside = glm::all(glm::greaterThanEqual(cam.position, b.lo)) && glm::all(glm::lessThanEqual(cam.position, b.hi));
-    if (!inside && !out_of_view(cam, b.lo, b.hi, float(std::max(cs.render.width, 1)) / float(std::max(cs.render.height, 1)))) return;
     const glm::vec3 centre = 0.5f * (b.lo + b.hi);
     const float radius = 0.5f * glm::length(b.hi - b.lo);
+    // Too near (within the bounds' sphere: inside them, or a 60 x 40 mm plate 4 mm away) or
+    // looking away.
+    const bool near = glm::length(cam.position - centre) < radius;
+    if (!near && !out_of_view(cam, b.lo, b.hi, float(std::max(cs.render.width, 1)) / float(std::max(cs.render.height, 1)))) return;
     const float dist = 1.05f * radius / std::sin(glm::radians(cam.fov) * 0.5f);
     if (!std::isfinite(dist) || !(dist > 0.0f)) return;
     ResolvedCamera framed = cam;
@@ -232,7 +234,8 @@ CompiledScene compile_scene(const Scene& scene) {
     cs.is_2d = scene.is_2d;
     cs.raw_field = scene.raw_field;
     cs.time = scene.time;
-    if (!c.loc.known() && !scene.is_2d && !scene.raw_field) frame_default_camera(cs);
+    // (not where the bounds may move with time: an animation's camera would follow them)
+    if (!c.loc.known() && !scene.is_2d && !scene.raw_field && !scene.reads_time) frame_default_camera(cs);
     return cs;
 }
 

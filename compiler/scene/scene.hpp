@@ -160,6 +160,7 @@ struct Scene {
     RenderSettings render;
     bool is_2d = false;      // a 2D .vm model (Prospero image)
     bool raw_field = false;  // a .vm model: root is a Field, no Lipschitz claim
+    bool reads_time = false;  // the script reads `time` (its bounds may move: no framed default camera)
     float time = 0.0f;       // the time the scene was built at (when not symbolic)
     std::shared_ptr<void> keepalive;  // what field closures need (the interpreter's state)
     // What the script does that is legal but likely not meant (an intersection of one

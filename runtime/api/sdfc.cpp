@@ -134,6 +134,8 @@ Image Scene::render(const RenderSettings& r) const {
     CompiledScene cs = s.compiled;  // the settings below are this call's
     if (r.width < 0 || r.height < 0 || r.samples < 0 || r.width > 16384 || r.height > 16384 || r.samples > 4096)
         throw Error("render: width and height must be from 1 to 16384 and samples from 1 to 4096 (0: the script's)");
+    // (as the command line's --threads: oneTBB's arena fails far above what it can run)
+    if (r.threads < 0 || r.threads > 1024) throw Error("render: threads must be from 1 to 1024 (0: all hardware threads)");
     if (r.width) cs.render.width = r.width;
     if (r.height) cs.render.height = r.height;
     if (r.samples) cs.render.samples = r.samples;

@@ -18,8 +18,14 @@ void* module_entry(const char* file, const char* env, const char* entry, std::st
     } else {
         std::error_code ec;
         const fs::path dir = fs::read_symlink("/proc/self/exe", ec).parent_path();
-        if (ec || dir.empty()) candidates = {fs::path(file)};  // the loader's own search
-        else candidates = {dir / file, dir.parent_path() / file, dir.parent_path() / "lib" / "sdfc" / file};
+        if (ec || dir.empty()) {
+            candidates = {fs::path(file)};  // the loader's own search
+        } else {
+            candidates = {dir / file, dir.parent_path() / "lib" / "sdfc" / file};
+            // (a test or bench tool in build/tests, build/bench: the build folder's; not beside
+            // a binary copied anywhere else, where a folder up may hold another build's module)
+            if (fs::exists(dir.parent_path() / "CMakeCache.txt", ec)) candidates.insert(candidates.begin() + 1, dir.parent_path() / file);
+        }
     }
     std::string tried;
     for (const fs::path& p : candidates) {

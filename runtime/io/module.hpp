@@ -7,7 +7,8 @@
 namespace sdfc {
 
 // The address of `entry` in the module `file`: looked for next to the executable (the build
-// folder), one folder up (a test in build/tests), or in ../lib/sdfc beside an installed bin/;
+// folder), one folder up when that is a build folder (a test in build/tests), or in
+// ../lib/sdfc beside an installed bin/;
 // the environment variable `env`, if set, names the file instead. nullptr, with `failure`
 // saying why ("not found (looked for ...)", the loader's error, or "not this build's ..."),
 // when it cannot be opened.

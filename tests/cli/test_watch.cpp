@@ -86,4 +86,9 @@ TEST_CASE("watch's usage errors") {
     auto bad = run_sdfc("watch --runs 1 check " + q(test::write_temp("watch_bad.sdf", "sphere(;\n")));
     CHECK(bad.status == 1);
     CHECK(bad.err.find("sdfc watch: run 1 failed in ") != std::string::npos);
+    // A command line no save can fix: watch stops (it waited for ever).
+    auto wrong = run_sdfc("watch render " + q(s));
+    CHECK(wrong.status == 2);
+    CHECK(wrong.err == "sdfc: error: render needs -o OUT\nsdfc: error: watch stops: the command line above is wrong, and no save of the scene "
+                       "can fix it\n");
 }

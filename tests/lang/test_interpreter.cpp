@@ -204,10 +204,15 @@ TEST_CASE("without camera(), a scene around the default camera or out of its vie
     CHECK(dist == Approx(1.05f * 20.0f * std::sqrt(3.0f) / std::sin(glm::radians(22.5f))).epsilon(0.01));
     CHECK(big.camera.position.z > 20.0f);  // outside the box, in front of it
     CHECK(test::dist(big, big.camera.position.x, big.camera.position.y, big.camera.position.z) > 0.0f);
+    // A plate just in front of the camera (not around it) is too.
+    auto plate = test::compile_text("box([60, 40, 2]);");
+    CHECK(plate->cs.camera.position.z > 50.0f);
     // A scene wholly out of the default view is framed too.
     auto behind = test::compile_text("translate([0, 0, 500]) sphere(1);");
     CHECK(behind->cs.camera.target.z == Approx(500.0f));
     CHECK(glm::length(behind->cs.camera.position - glm::vec3(0, 0, 500)) < 10.0f);
+    // Not in a script that reads time (an animation's camera would follow its bounds).
+    CHECK(test::compile_text("translate([0, 0, time]) box(40);")->cs.camera.position == glm::vec3(0, 0, 5));
     // Elsewhere, and with a camera(), the camera stays where it was put.
     CHECK(test::compile_text("sphere(1);")->cs.camera.position == glm::vec3(0, 0, 5));
     CHECK(test::compile_text("camera(position = [0, 0, 5]); box(40);")->cs.camera.position == glm::vec3(0, 0, 5));
