@@ -28,6 +28,7 @@ std::optional<long> env_number(const char* name) {
 std::pair<int, int> index_of_count(const std::string& flag, const std::string& v) {
     const size_t slash = v.find('/');
     if (slash == std::string::npos) throw UsageError(fmt::format("{} takes I/N (this task's index and the count), not '{}'", flag, v));
+    (void)Args::to_int(flag, v.substr(0, slash), 0, 1000000000);  // (a bad I is named before N)
     const int n = Args::to_int(flag, v.substr(slash + 1), 1, 1000000000);
     const int i = Args::to_int(flag, v.substr(0, slash), 0, n - 1);
     return {i, n};
@@ -134,12 +135,12 @@ int cmd_merge(Args& a) {
     for (size_t k : order) {
         const Image& b = bands[k];
         const std::string& name = parts[k];
+        if (b.picture != first.picture)
+            throw std::runtime_error(fmt::format("'{}' is a band of another picture than '{}' (another scene, frame, setting or AOV)", name,
+                                                 parts[order[0]]));
         if (b.width != img.width || b.full_height != img.height || b.channels != img.channels || b.aovs.size() != img.aovs.size())
             throw std::runtime_error(fmt::format("'{}' is a band of another picture ({}x{}, {} channels) than '{}' ({}x{}, {} channels)", name,
                                                  b.width, b.full_height, b.channels, parts[order[0]], img.width, img.height, img.channels));
-        if (b.picture != first.picture)
-            throw std::runtime_error(fmt::format("'{}' is a band of another picture than '{}' (another scene, frame or setting)", name,
-                                                 parts[order[0]]));
         if (b.row0 != next)
             throw std::runtime_error(b.row0 > next ? fmt::format("rows {} to {} are in none of the bands", next, b.row0 - 1)
                                                    : fmt::format("'{}' overlaps another band (rows {} to {})", name, b.row0, next - 1));
