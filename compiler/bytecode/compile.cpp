@@ -162,8 +162,9 @@ namespace {
 
 // A script without camera() whose scene's bounding sphere holds the default camera (a model
 // in millimetres, as OpenSCAD's are, around or just before a camera at [0, 0, 5]) or lies
-// wholly out of its view is seen from outside instead: from the front, right and above (as OpenSCAD's first view), from where its
-// bounding sphere fills the vertical field of view. Elsewhere the default stays (LANGUAGE.md section 8).
+// wholly out of its view is seen from outside instead: from the front, right and above (as
+// OpenSCAD's first view), from where its bounding sphere fills the vertical field of view.
+// Elsewhere the default stays (LANGUAGE.md section 8).
 void frame_default_camera(CompiledScene& cs) {
     const Bounds& b = cs.bounds.finite() ? cs.bounds : cs.solid_bounds;
     if (!b.finite() || !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) return;
