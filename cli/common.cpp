@@ -154,19 +154,7 @@ void progress_line(const std::string& target, double frac, double elapsed_s, dou
 
 void read_points(const std::string& path, size_t max_bytes, std::vector<float>& xs, std::vector<float>& ys, std::vector<float>& zs) {
     // A bad line is an error in an input file: path:line:col, the line and a caret, exit 1.
-    std::string text;
-    if (path == "-") {  // standard input, bounded as a file is
-        char buf[1 << 16];
-        for (size_t n; (n = std::fread(buf, 1, sizeof buf, stdin)) > 0;) {
-            text.append(buf, n);
-            if (text.size() > max_bytes)
-                throw std::runtime_error(fmt::format("standard input is over the limit of {} bytes (raise it with --max-file-size)", max_bytes));
-        }
-        if (std::ferror(stdin)) throw std::runtime_error(fmt::format("cannot read standard input: {}", std::strerror(errno)));
-    } else {
-        text = read_bounded(path, max_bytes);
-    }
-    const SourceFile file(path == "-" ? "<stdin>" : path, std::move(text));
+    const SourceFile file(path == "-" ? "<stdin>" : path, read_bounded(path, max_bytes));  // (-: standard input)
     for (uint32_t ln = 1; ln <= file.line_starts.size(); ++ln) {
         const std::string_view line = file.line(ln);
         float v[3];

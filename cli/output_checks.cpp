@@ -61,26 +61,34 @@ void check_not_input(const std::string& out, const SourceManager& sm) {
 }
 
 std::string read_bounded(const std::string& path, size_t max_bytes) {
-    struct stat st {};
-    if (::stat(path.c_str(), &st) != 0) throw std::runtime_error(fmt::format("cannot read '{}': {}", path, std::strerror(errno)));
-    if (S_ISDIR(st.st_mode)) throw std::runtime_error(fmt::format("cannot read '{}': {}", path, std::strerror(EISDIR)));
-    FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) throw std::runtime_error(fmt::format("cannot read '{}': {}", path, std::strerror(errno)));
+    const bool in = path == "-";
+    const std::string what = in ? "standard input" : "'" + path + "'";
+    FILE* f = stdin;
+    if (!in) {
+        struct stat st {};
+        if (::stat(path.c_str(), &st) != 0) throw std::runtime_error(fmt::format("cannot read {}: {}", what, std::strerror(errno)));
+        if (S_ISDIR(st.st_mode)) throw std::runtime_error(fmt::format("cannot read {}: {}", what, std::strerror(EISDIR)));
+        f = std::fopen(path.c_str(), "rb");
+        if (!f) throw std::runtime_error(fmt::format("cannot read {}: {}", what, std::strerror(errno)));
+    }
+    auto close = [&] {
+        if (!in) std::fclose(f);
+    };
     std::string data;
     char buf[1 << 16];
     for (;;) {
         size_t n = std::fread(buf, 1, sizeof buf, f);
         data.append(buf, n);
         if (data.size() > max_bytes) {
-            std::fclose(f);
-            throw std::runtime_error(fmt::format("'{}' is over the limit of {} bytes (raise it with --max-file-size)", path, max_bytes));
+            close();
+            throw std::runtime_error(fmt::format("{} is over the limit of {} bytes (raise it with --max-file-size)", what, max_bytes));
         }
         if (n < sizeof buf) break;
     }
     const bool failed = std::ferror(f);
     const int err = errno;
-    std::fclose(f);
-    if (failed) throw std::runtime_error(fmt::format("cannot read '{}': {}", path, std::strerror(err)));
+    close();
+    if (failed) throw std::runtime_error(fmt::format("cannot read {}: {}", what, std::strerror(err)));
     return data;
 }
 

@@ -20,8 +20,8 @@ void check_picture_output(const std::string& out, const std::string& format);
 void check_not_input(const std::string& out, const std::string& scene);
 void check_not_input(const std::string& out, const SourceManager& sm);
 
-// The whole file, at most `max_bytes` of it (a device like /dev/zero never ends); a clear
-// error for a directory, a missing or unreadable file, or one over the limit.
+// The whole file ("-": standard input), at most `max_bytes` of it (a device like /dev/zero
+// never ends); a clear error for a directory, a missing or unreadable file, or one over the limit.
 std::string read_bounded(const std::string& path, size_t max_bytes);
 
 // Standard output: written here, any failure reported (once) as

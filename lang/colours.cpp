@@ -25,7 +25,7 @@ Value Interp::colour_name(const std::string& name, Loc loc) {
     // "#rgba" and "#rrggbbaa" (CSS's): the alpha is not a colour's, as color([r, g, b, a])'s.
     if (name.size() == 5 || name.size() == 9) {
         const std::string_view a = std::string_view(name).substr(name.size() == 5 ? 4 : 7);
-        if (name[0] == '#' && a != "f" && a != "F" && a != "ff" && a != "FF" && a != "fF" && a != "Ff")
+        if (name[0] == '#' && a.find_first_not_of("fF") != std::string_view::npos)
             warn(loc, "the colour's alpha is ignored: for see-through, material(transparency = ...)");
     }
     // sRGB bytes, made linear like every colour of a scene.
