@@ -294,7 +294,16 @@ struct brace_primary : sor<block, field_expr, if_expr, for_expr> {};
 // (The guard comes after the nesting check: the depth limit applies to every attempt.)
 struct ident_postfix;
 struct target_start : sor<one<'{'>, identifier_first, digit> {};
-struct apply_target : seq<at<target_start>, sor<block, for_expr, if_expr, field_expr, ternary>>, nesting {};
+// An `if` target, or one inside a `for` target, may also end its first branch with ';'
+// before `else`, as OpenSCAD's `translate(v) if (c) a(); else b();` does (the else goes
+// with the nearest if).
+struct semi_else : seq<semi, kw<kw_else>> {};
+struct target_if;
+struct target_for;
+struct target_branch : sor<target_if, target_for, branch_expr>, nesting {};
+struct target_if : seq<if_header, target_branch, opt<sor<kw<kw_else>, semi_else>, target_branch>> {};
+struct target_for : seq<for_header, target_branch> {};
+struct apply_target : seq<at<target_start>, sor<block, target_for, target_if, field_expr, ternary>>, nesting {};
 struct ident_postfix : seq<at<identifier_first>, ident_expr, postfix_ops, opt<apply_target>> {};
 struct other_postfix : seq<simple_primary, postfix_ops> {};
 struct postfix_expr : sor<ident_postfix, other_postfix, brace_primary> {};

@@ -394,6 +394,11 @@ struct action<g::if_expr> {
 };
 
 template <>
+struct action<g::target_if> : action<g::if_expr> {};
+template <>
+struct action<g::target_for> : action<g::for_expr> {};
+
+template <>
 struct action<g::field_expr> {
     template <typename In>
     static void apply(const In& in, State& st) {

@@ -26,11 +26,16 @@ struct PreviewServer {
         std::string report = "{}";   // the page's last report, as JSON
         std::string token;           // this server's: a page of an earlier one is refused
         bool stopping = false;
+        int streams = 0;             // /events streams open now
     };
     std::shared_ptr<Shared> shared = std::make_shared<Shared>();
 };
 
 namespace {
+
+// httplib's default pool has max(8, cores - 1) threads: five open pages, their streams and
+// kept-alive connections, were enough to stall the next page load.
+constexpr int kWorkers = 64, kMaxStreams = 48;
 
 void routes(httplib::Server& http, const std::shared_ptr<PreviewServer::Shared>& live, const std::string& page) {
     http.Get("/", [page](const httplib::Request&, httplib::Response& res) {
@@ -39,9 +44,26 @@ void routes(httplib::Server& http, const std::shared_ptr<PreviewServer::Shared>&
     });
     // The stream: the newest build at once, then each new one; a comment every 15 s finds
     // pages that went away (the write fails and the thread is free again).
+    // Each open stream holds one of the server's threads (kWorkers) for as long as its page
+    // lives: past kMaxStreams a new one is refused (503), so page loads and reports always
+    // find a thread.
     http.Get("/events", [live](const httplib::Request&, httplib::Response& res) {
         res.set_header("Cache-Control", "no-store");
-        res.set_chunked_content_provider("text/event-stream", [live, sent = 0L](size_t, httplib::DataSink& sink) mutable {
+        {
+            std::lock_guard<std::mutex> lock(live->m);
+            if (live->streams >= kMaxStreams) {
+                res.status = 503;
+                res.set_content(fmt::format("{} pages are open on this preview already\n", kMaxStreams), "text/plain");
+                return;
+            }
+            ++live->streams;
+        }
+        // Counted open while any copy of the provider lives.
+        auto slot = std::shared_ptr<void>(nullptr, [live](void*) {
+            std::lock_guard<std::mutex> lock(live->m);
+            --live->streams;
+        });
+        res.set_chunked_content_provider("text/event-stream", [live, slot, sent = 0L](size_t, httplib::DataSink& sink) mutable {
             std::unique_lock<std::mutex> lock(live->m);
             live->changed.wait_for(lock, std::chrono::seconds(15), [&] { return live->version != sent || live->stopping; });
             if (live->stopping) return false;
@@ -90,6 +112,7 @@ PreviewServer* start(const std::string& host, int port, const std::string& page,
     auto s = std::make_unique<PreviewServer>();
     s->shared->token = token;
     routes(s->http, s->shared, page);
+    s->http.new_task_queue = [] { return new httplib::ThreadPool(kWorkers); };
     // SO_REUSEADDR only: httplib's default, SO_REUSEPORT, lets a second preview bind the same
     // port, and the kernel then splits the connections between the two.
     s->http.set_socket_options([](socket_t sock) {

@@ -19,6 +19,7 @@
 #include <regex>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 #include <httplib.h>
 
@@ -71,8 +72,8 @@ int port_from(const std::string& log) {
 }
 
 // The first `n` events on /events (what a page gets when it connects), as sent: read from a
-// socket of its own, closed after them (the stream itself never ends).
-std::string first_events(int port, int n = 1) {
+// socket of its own, closed after them (the stream itself never ends) unless `keep` takes it.
+std::string first_events(int port, int n = 1, int* keep = nullptr) {
     const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
     REQUIRE(fd >= 0);
     sockaddr_in addr{};
@@ -90,12 +91,15 @@ std::string first_events(int port, int n = 1) {
                 const ssize_t k = ::recv(fd, buf, sizeof buf, 0);
                 if (k <= 0) break;
                 got.append(buf, size_t(k));
+                if (got.size() >= 12 && got.compare(0, 12, "HTTP/1.1 200") != 0) break;  // refused: no stream
                 seen = 0;
                 for (size_t at = 0; (at = got.find("\n\n", at)) != std::string::npos; at += 2) ++seen;
             }
         }
     }
-    ::close(fd);
+    if (keep) *keep = fd;
+    else ::close(fd);
+    if (got.compare(0, 12, "HTTP/1.1 200") != 0) return "";
     const size_t body = got.find("\r\n\r\n");  // after the headers, the chunks: their sizes on lines of their own
     std::string events;
     for (size_t at = body == std::string::npos ? got.size() : body + 4; at < got.size();) {
@@ -165,6 +169,41 @@ TEST_CASE("preview serves the live page and sends each save's shader or error") 
     auto stale = cli.Post("/report", "server=someone-else&version=9", "application/x-www-form-urlencoded");
     REQUIRE(stale);
     CHECK(stale->status == 409);
+}
+
+TEST_CASE("many open pages: each has its stream, page loads still answer, past 48 streams a 503") {
+    const std::string dir = test::temp_dir() + "/preview-many";
+    fs::create_directories(dir);
+    const std::string scene = dir + "/scene.sdf", log = dir + "/log.txt";
+    save(scene, kRed);
+    Background server("'" + std::string(SDFC_BIN_PATH) + "' preview --port 0 " + q(scene), log);
+    const int port = port_from(log);
+    REQUIRE(port > 0);
+    REQUIRE(eventually([&] { return test::slurp(log); }, [](const std::string& s) { return s.find("version 1 ok in ") != std::string::npos; }));
+    std::vector<int> open;
+    for (int i = 0; i < 48; ++i) {  // httplib's own pool had 8 threads: the 9th page waited for ever
+        int fd = -1;
+        REQUIRE(first_events(port, 1, &fd).find("\"version\":1,") != std::string::npos);
+        open.push_back(fd);
+    }
+    httplib::Client cli("127.0.0.1", port);
+    cli.set_read_timeout(20, 0);
+    auto page = cli.Get("/");
+    REQUIRE(page);
+    CHECK(page->status == 200);
+    auto refused = cli.Get("/events");
+    REQUIRE(refused);
+    CHECK(refused->status == 503);
+    CHECK(refused->body == "48 pages are open on this preview already\n");
+    // A page goes away (reset, so the server's next write fails at once): its slot is free.
+    linger reset{1, 0};
+    ::setsockopt(open.back(), SOL_SOCKET, SO_LINGER, &reset, sizeof reset);
+    ::close(open.back());
+    open.pop_back();
+    save(scene, kBlue);
+    CHECK(eventually([&] { return test::slurp(log); }, [](const std::string& s) { return s.find("version 2 ok in ") != std::string::npos; }));
+    CHECK(eventually([&] { return first_events(port); }, [](const std::string& e) { return e.find("\"version\":2,") != std::string::npos; }));
+    for (int fd : open) ::close(fd);
 }
 
 TEST_CASE("preview's usage errors") {

@@ -36,6 +36,23 @@ TEST_CASE("a modifier takes a conditional shape, bare or in parentheses", "[lang
           "test.sdf:1:23: error: the target of translate must be a shape, not a number");
 }
 
+TEST_CASE("a modifier takes an if with else written as OpenSCAD's statements, ';' before else", "[lang]") {
+    CHECK(dist_of("let k = 0;\ntranslate([5, 0, 0]) if (k > 0) sphere(0.5); else box(1);", 5, 0, 0) == Approx(-0.5f));
+    CHECK(dist_of("let k = 1;\ntranslate([5, 0, 0]) if (k > 0) sphere(0.5); else box(1);", 5, 0, 0) == Approx(-0.5f));
+    // Chains, else if, a user modifier, a for target, inside a block.
+    const std::string s = "def up(s) = translate([0, 3, 0]) s;\n"
+                          "union {\n"
+                          "  translate([5, 0, 0]) up() if (1 > 2) sphere(0.5); else if (2 > 3) sphere(2); else box(1);\n"
+                          "  translate([0, 6, 0]) for (i = [0:1]) if (i == 0) sphere(0.25); else translate([0, 0, 3]) box(1);\n"
+                          "}\n";
+    CHECK(dist_of(s, 5, 3, 0) == Approx(-0.5f));
+    CHECK(dist_of(s, 0, 6, 0) == Approx(-0.25f));
+    CHECK(dist_of(s, 0, 6, 3) == Approx(-0.5f));
+    // The else goes with the nearest if, as in OpenSCAD.
+    CHECK(dist_of("if (true) translate([5, 0, 0]) if (false) sphere(0.5); else box(1);", 5, 0, 0) == Approx(-0.5f));
+    CHECK(first_error_line("translate([5, 0, 0]) if (true) sphere(1); else;") == "test.sdf:1:48: error: expected an expression");
+}
+
 TEST_CASE("a user modifier's errors name it", "[lang]") {
     CHECK(first_error_line("def f(x) = x * 2;\nf(1) sphere(1);") ==
           "test.sdf:2:1: error: a number is written before a shape but is not an operation");
