@@ -144,8 +144,17 @@ TEST_CASE("deep nesting is an error, not a crash", "[parser]") {
 TEST_CASE("the nesting limit is a parameter", "[parser]") {
     ParseOptions opts;
     opts.max_nesting = 10;
-    CHECK(error_of("x = ((((((((((1))))))))));", opts) == "1:14: nesting deeper than 10 levels (raise it with --max-nesting)");
-    CHECK_NOTHROW(parse_text("x = ((((((1))))));", opts));
+    // A top-level statement is no level; a call's parentheses are one, as is a value's
+    // expression, each parenthesis in it another.
+    CHECK(error_of("x = ((((((((((1))))))))));", opts) == "1:15: nesting deeper than 10 levels (raise it with --max-nesting)");
+    CHECK_NOTHROW(parse_text("x = (((((((((1)))))))));", opts));
+    CHECK_NOTHROW(parse_text("sphere((((((((((1))))))))));", opts));  // 10 parentheses
+    CHECK(error_of("sphere(((((((((((1)))))))))));", opts) == "1:18: nesting deeper than 10 levels (raise it with --max-nesting)");
+    opts.max_nesting = 3;
+    CHECK_NOTHROW(parse_text("translate(v) { sphere(1); }", opts));  // a modifier and its block count 2
+    CHECK(error_of("translate(v) { sphere((1)); }", opts) == "1:24: nesting deeper than 3 levels (raise it with --max-nesting)");
+    opts.max_nesting = 1;
+    CHECK_NOTHROW(parse_text("sphere(1);", opts));
     // The default allows realistic depth.
     std::string s = "x = " + std::string(200, '(') + "1" + std::string(200, ')') + ";";
     CHECK_NOTHROW(parse_text(s));
@@ -201,10 +210,10 @@ TEST_CASE("the nesting limit, not the caller's stack, decides where deep input s
         deep_error = error_of(deep, opts);
     });
     CHECK(ok_error == "no error");
-    CHECK(deep_error == "1:1028: nesting deeper than 1024 levels (raise it with --max-nesting)");
+    CHECK(deep_error == "1:1029: nesting deeper than 1024 levels (raise it with --max-nesting)");
     // And on this thread, deeper than its stack allows (the main thread's 8 MB holds about
     // 1,000 levels in sanitizer builds).
     opts.max_nesting = 3000;
     CHECK(error_of("x = " + std::string(2990, '(') + "1" + std::string(2990, ')') + ";", opts) == "no error");
-    CHECK(error_of(deep, opts) == "1:3004: nesting deeper than 3000 levels (raise it with --max-nesting)");
+    CHECK(error_of(deep, opts) == "1:3005: nesting deeper than 3000 levels (raise it with --max-nesting)");
 }

@@ -36,7 +36,7 @@ TEST_CASE("a modifier takes a conditional shape, bare or in parentheses", "[lang
           "test.sdf:1:23: error: the target of translate must be a shape, not a number");
 }
 
-TEST_CASE("a modifier takes an if with else written as OpenSCAD's statements, ';' before else", "[lang]") {
+TEST_CASE("a modifier takes an if with else written as OpenSCAD's statements (its first branch ended before else)", "[lang]") {
     CHECK(dist_of("let k = 0;\ntranslate([5, 0, 0]) if (k > 0) sphere(0.5); else box(1);", 5, 0, 0) == Approx(-0.5f));
     CHECK(dist_of("let k = 1;\ntranslate([5, 0, 0]) if (k > 0) sphere(0.5); else box(1);", 5, 0, 0) == Approx(-0.5f));
     // Chains, else if, a user modifier, a for target, inside a block.
@@ -50,7 +50,7 @@ TEST_CASE("a modifier takes an if with else written as OpenSCAD's statements, ';
     CHECK(dist_of(s, 0, 6, 3) == Approx(-0.5f));
     // The else goes with the nearest if, as in OpenSCAD.
     CHECK(dist_of("if (true) translate([5, 0, 0]) if (false) sphere(0.5); else box(1);", 5, 0, 0) == Approx(-0.5f));
-    CHECK(first_error_line("translate([5, 0, 0]) if (true) sphere(1); else;") == "test.sdf:1:48: error: expected an expression");
+    CHECK(first_error_line("translate([5, 0, 0]) if (true) sphere(1); else;") == "test.sdf:1:47: error: expected an expression");
 }
 
 TEST_CASE("a user modifier's errors name it", "[lang]") {
