@@ -21,8 +21,12 @@ namespace sdfc {
 
 SourceFile::SourceFile(std::string p, std::string t) : path(std::move(p)), text(std::move(t)) {
     line_starts.push_back(0);
-    for (size_t i = 0; i < text.size(); ++i)
+    for (size_t i = 0; i < text.size(); ++i) {
+        // A lone CR (classic Mac OS line ends) ends a line as editors show it; the grammar
+        // knows "\n" and "\r\n" only, and a // comment would run to the file's end.
+        if (text[i] == '\r' && (i + 1 == text.size() || text[i + 1] != '\n')) text[i] = '\n';
         if (text[i] == '\n') line_starts.push_back(i + 1);
+    }
 }
 
 std::string_view SourceFile::line(uint32_t n) const {

@@ -198,6 +198,10 @@ TEST_CASE("binary files and invalid UTF-8 are errors at the offending byte") {
     // Well-formed UTF-8 in comments and strings, a byte-order mark, CRLF lines: fine.
     d.write("good.sdf", "\xef\xbb\xbf// caf\xc3\xa9 \xe2\x9c\x93 \xf0\x9f\x8e\x89\r\nlet s = \"\xc3\xa9\";\r\nsphere(1);\r\n");
     CHECK(d.errors("good.sdf") == "");
+    // Lone CRs (classic Mac OS) end lines too: a // comment stops there, errors count them.
+    d.write("mac.sdf", "let a = 1;\r// note\rsphere(a);\rbox(;\r");
+    CHECK(d.first_error("mac.sdf") == "DIR/mac.sdf:4:5: error: expected ')'");
+    CHECK(d.errors("mac.sdf").find("\nbox(;\n    ^") != std::string::npos);
     // A non-ASCII character in code is a syntax error naming it.
     d.write("name.sdf", "let caf\xc3\xa9 = 1;\n");
     CHECK(d.first_error("name.sdf") == "DIR/name.sdf:1:8: error: unexpected character '\xc3\xa9'");
