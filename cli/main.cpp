@@ -234,7 +234,7 @@ int cmd_render(Args& a) {
     if (scenes.size() > 1 && out->find("{name}") == std::string::npos)
         throw UsageError("rendering several scenes needs {name} in the output name");
     const size_t items = scenes.size() * size_t(f1 - f0 + 1);
-    if (items > 1) check_distinct_outputs(*out, scenes, f0, f1);
+    if (items > 1) check_distinct_outputs(*out, scenes, f0, f1, ro.aovs);
     if (bands && items > 1) throw UsageError("--tiles renders one band of one picture: give one scene and one frame");
     const Shard shard = read_shard(shard_s, items);
     // Item k (the scenes' frames in order) is this task's when k % count == index.
@@ -247,18 +247,31 @@ int cmd_render(Args& a) {
         std::fprintf(stderr, "sdfc: shard %d/%d: none of the %zu pictures\n", shard.index, shard.count, items);
     if (*out == "-" && !ro.aovs.empty() && fmt_ext != "exr")
         throw UsageError("--aov to standard output needs --format exr (as channels: side files need a file name)");
-    // The outputs can be written (folder, format, not a directory...) before any work.
-    for (const std::string& path : scenes) {
-        std::string name = scene_name(path);
-        for (int f : {f0, f1}) {
-            std::string target = expand(*out, f, name);
-            check_picture_output(target, fmt_ext);
-            check_not_input(target, path);
-            if (!is_exr(target) && target != "-")
-                for (const std::string& av : ro.aovs) check_image_output(aov_side_path(target, av));
+    // Each of this task's outputs can be written (folder, format, not a directory...) and is
+    // no scene of the batch, before any work; no import either, once the batch compiled.
+    InputFiles inputs;
+    for (const std::string& path : scenes) inputs.add(path, true);
+    auto check_outputs = [&](bool writable) {
+        for (size_t i = 0; i < scenes.size(); ++i) {
+            const std::string name = scene_name(scenes[i]);
+            for (int f = f0; f <= f1; ++f) {
+                if (!mine(i, f)) continue;
+                const std::string target = expand(*out, f, name);
+                if (writable) check_picture_output(target, fmt_ext);
+                inputs.check(target);
+                if (!is_exr(target) && target != "-")
+                    for (const std::string& av : ro.aovs) {
+                        if (writable) check_image_output(aov_side_path(target, av));
+                        inputs.check(aov_side_path(target, av));
+                    }
+            }
         }
-    }
+    };
+    check_outputs(true);
     float base_time = time_s ? Args::to_float("--time", *time_s) : 0.0f;
+    // Every scene and import is read once, for all frames (a save during the batch waits
+    // for the next run).
+    const auto snapshot = std::make_shared<SourceSnapshot>();
     auto compile_frame = [&](SourceManager& sm, const std::string& path, int f) {
         float t = animated ? base_time + float(f) / fps : base_time;
         CompiledScene cs;
@@ -292,9 +305,13 @@ int cmd_render(Args& a) {
         for (size_t i = 0; i < scenes.size(); ++i)
             for (int f = f0; f <= f1; ++f) {
                 if (!todo(i, f)) continue;
-                SourceManager sm;
+                SourceManager sm(snapshot);
                 (void)compile_frame(sm, scenes[i], f);
             }
+    if (my_items > 1) {
+        for (const auto& [path, text] : snapshot->texts) inputs.add(path, false);
+        check_outputs(false);
+    }
     // One bar for the whole batch (frames of several scenes): "frame 3/24", the ETA of all.
     int total = 0;
     for (size_t i = 0; i < scenes.size(); ++i)
@@ -313,7 +330,7 @@ int cmd_render(Args& a) {
                 if (!quiet) std::fprintf(stderr, "sdfc: skipped %s (it is there)\n", target.c_str());
                 continue;
             }
-            SourceManager sm;
+            SourceManager sm(snapshot);
             CompiledScene cs = compile_frame(sm, path, f);
             check_not_input(target, sm);
             if (!is_exr(target) && target != "-")

@@ -60,6 +60,23 @@ void check_not_input(const std::string& out, const SourceManager& sm) {
                                             : fmt::format("cannot write '{}': the scene imports it ('{}')", out, paths[i]));
 }
 
+void InputFiles::add(const std::string& path, bool scene) {
+    struct stat st {};
+    if (path == "-" || ::stat(path.c_str(), &st) != 0) return;
+    for (const Id& id : ids_)
+        if (id.dev == st.st_dev && id.ino == st.st_ino) return;
+    ids_.push_back(Id{st.st_dev, st.st_ino, path, scene});
+}
+
+void InputFiles::check(const std::string& out) const {
+    struct stat st {};
+    if (ids_.empty() || out == "-" || ::stat(out.c_str(), &st) != 0) return;
+    for (const Id& id : ids_)
+        if (id.dev == st.st_dev && id.ino == st.st_ino)
+            throw std::runtime_error(id.scene ? fmt::format("cannot write '{}': it is the scene file '{}'", out, id.path)
+                                              : fmt::format("cannot write '{}': a scene imports it ('{}')", out, id.path));
+}
+
 std::string read_bounded(const std::string& path, size_t max_bytes) {
     const bool in = path == "-";
     const std::string what = in ? "standard input" : "'" + path + "'";

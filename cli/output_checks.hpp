@@ -4,6 +4,7 @@
 #pragma once
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "compiler/base/source.hpp"
 #include "compiler/bytecode/compile.hpp"
@@ -19,6 +20,22 @@ bool is_exr(const std::string& path);
 void check_picture_output(const std::string& out, const std::string& format);
 void check_not_input(const std::string& out, const std::string& scene);
 void check_not_input(const std::string& out, const SourceManager& sm);
+
+// The files a batch reads (every scene, every import), by identity (device and inode): an
+// output of any picture must be none of them.
+class InputFiles {
+public:
+    void add(const std::string& path, bool scene);  // a file that is not there is no input
+    void check(const std::string& out) const;         // the std::runtime_error of check_not_input
+
+private:
+    struct Id {
+        unsigned long long dev, ino;
+        std::string path;
+        bool scene;
+    };
+    std::vector<Id> ids_;
+};
 
 // The whole file ("-": standard input), at most `max_bytes` of it (a device like /dev/zero
 // never ends); a clear error for a directory, a missing or unreadable file, or one over the limit.

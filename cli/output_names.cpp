@@ -1,5 +1,6 @@
 #include "cli/output_names.hpp"
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <unordered_map>
@@ -7,6 +8,8 @@
 #include <fmt/format.h>
 
 #include "cli/args.hpp"
+#include "cli/output_checks.hpp"
+#include "runtime/io/image.hpp"
 
 namespace sdfc::cli {
 
@@ -40,8 +43,9 @@ std::string expand(const std::string& out, int frame, const std::string& name) {
             const std::string digits = spec.empty() ? spec : spec.substr(0, spec.size() - 1);
             if (spec.empty() || spec.back() != 'd' || digits.find_first_not_of("0123456789") != std::string::npos)
                 throw UsageError(fmt::format("unsupported frame format '{{frame:{}}}' (use {{frame:04d}})", spec));
-            const int width = digits.empty() ? 0 : std::atoi(digits.c_str());
-            if (digits.size() > 2 || width > 32)
+            const size_t lead = std::min(digits.find_first_not_of('0'), digits.size());  // 010d: width 10
+            const int width = digits.size() - lead > 2 ? 99 : std::atoi(digits.c_str() + lead);
+            if (width > 32)
                 throw UsageError(fmt::format("unsupported frame format '{{frame:{}}}' (at most 32 digits)", spec));
             r += fmt::format("{:0{}d}", frame, width);
         } else {
@@ -54,17 +58,38 @@ std::string expand(const std::string& out, int frame, const std::string& name) {
     return r;
 }
 
-void check_distinct_outputs(const std::string& out, const std::vector<std::string>& scenes, int f0, int f1) {
-    std::unordered_map<std::string, std::pair<size_t, int>> seen;
-    for (size_t i = 0; i < scenes.size(); ++i)
-        for (int f = f0; f <= f1; ++f) {
-            const auto [it, fresh] = seen.emplace(expand(out, f, scene_name(scenes[i])), std::make_pair(i, f));
-            if (fresh) continue;
-            const auto [j, g] = it->second;
-            if (j == i) throw UsageError(fmt::format("frames {} and {} would both be written to '{}'", g, f, it->first));
+void check_distinct_outputs(const std::string& out, const std::vector<std::string>& scenes, int f0, int f1,
+                            const std::vector<std::string>& side_aovs) {
+    struct Written {
+        size_t scene;
+        int frame;
+        std::string aov;  // empty: the picture, else its side file
+    };
+    std::unordered_map<std::string, Written> seen;
+    auto what = [&](const Written& w) {
+        std::string s = w.aov.empty() ? "" : fmt::format("the {} side file of ", w.aov);
+        s += fmt::format("'{}'", scenes[w.scene]);
+        if (f1 > f0) s += fmt::format(" frame {}", w.frame);
+        return s;
+    };
+    auto note = [&](const std::string& path, const Written& w) {
+        const auto [it, fresh] = seen.emplace(path, w);
+        if (fresh) return;
+        const Written& v = it->second;
+        if (v.scene == w.scene && v.aov.empty() && w.aov.empty())
+            throw UsageError(fmt::format("frames {} and {} would both be written to '{}'", v.frame, w.frame, path));
+        if (v.aov.empty() && w.aov.empty())
             throw UsageError(fmt::format("'{}' and '{}' would both be written to '{}' ({{name}} is the file name without its "
                                          "folder and extension)",
-                                         scenes[j], scenes[i], it->first));
+                                         scenes[v.scene], scenes[w.scene], path));
+        throw UsageError(fmt::format("{} and {} would both be written to '{}'", what(v), what(w), path));
+    };
+    for (size_t i = 0; i < scenes.size(); ++i)
+        for (int f = f0; f <= f1; ++f) {
+            const std::string target = expand(out, f, scene_name(scenes[i]));
+            note(target, Written{i, f, ""});
+            if (target != "-" && !is_exr(target))
+                for (const std::string& a : side_aovs) note(aov_side_path(target, a), Written{i, f, a});
         }
 }
 

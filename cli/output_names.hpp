@@ -14,8 +14,9 @@ std::string scene_name(const std::string& path);
 // frame to one file).
 std::string expand(const std::string& out, int frame, const std::string& name);
 
-// A UsageError when two of the pictures (each scene's frames f0..f1) would be written to one
-// file: the second would replace the first.
-void check_distinct_outputs(const std::string& out, const std::vector<std::string>& scenes, int f0, int f1);
+// A UsageError when two of the pictures (each scene's frames f0..f1), or their side files of
+// `side_aovs` (outside EXR), would be written to one file: the second would replace the first.
+void check_distinct_outputs(const std::string& out, const std::vector<std::string>& scenes, int f0, int f1,
+                            const std::vector<std::string>& side_aovs = {});
 
 }  // namespace sdfc::cli

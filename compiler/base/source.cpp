@@ -187,6 +187,28 @@ std::vector<std::string> take_loaded_paths() {
 
 const SourceFile& SourceManager::load(const std::string& path, Loc from, size_t max_bytes) {
     note_loaded(path);
+    std::string text;
+    bool known = false;
+    if (snapshot_) {
+        std::lock_guard<std::mutex> lock(snapshot_->m);
+        if (auto it = snapshot_->texts.find(path); it != snapshot_->texts.end()) text = it->second, known = true;
+    }
+    if (known) {
+        if (text.size() > max_bytes)
+            throw CompileError(from, fmt::format("'{}' is over the limit of {} bytes (--max-file-size)", path, max_bytes));
+    } else {
+        text = read(path, from, max_bytes);
+        if (snapshot_) {
+            std::lock_guard<std::mutex> lock(snapshot_->m);
+            snapshot_->texts.emplace(path, text);
+        }
+    }
+    const SourceFile& f = add(path, std::move(text));
+    check_source_text(f);
+    return f;
+}
+
+std::string SourceManager::read(const std::string& path, Loc from, size_t max_bytes) {
     // Only regular files: opening a FIFO would block, a device may never end.
     std::error_code ec;
     auto st = std::filesystem::status(path, ec);
@@ -218,9 +240,7 @@ const SourceFile& SourceManager::load(const std::string& path, Loc from, size_t 
     if (in.bad()) throw CompileError(from, fmt::format("cannot read '{}'", path));
     // A UTF-8 byte-order mark is no text: columns of the first line count from after it.
     if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
-    const SourceFile& f = add(path, std::move(text));
-    check_source_text(f);
-    return f;
+    return text;
 }
 
 const SourceFile& SourceManager::load_stdin(size_t max_bytes) {

@@ -4,7 +4,9 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -68,10 +70,21 @@ void check_source_text(const SourceFile& f);
 // last call: the files `sdfc watch` watches (a scene and all it imports).
 std::vector<std::string> take_loaded_paths();
 
+// The texts of the files a command read, by path: managers that share one (the frames and
+// scenes of a render batch) read each file once, so a save during the batch cannot mix two
+// versions of a script into one animation.
+struct SourceSnapshot {
+    std::mutex m;
+    std::map<std::string, std::string> texts;
+};
+
 class SourceManager {
 public:
-    // Reads a file; throws CompileError at `from` (the import or command line) on failure,
-    // or for binary/invalid UTF-8 content or a file over `max_bytes`.
+    SourceManager() = default;
+    explicit SourceManager(std::shared_ptr<SourceSnapshot> snapshot) : snapshot_(std::move(snapshot)) {}
+    // Reads a file (or takes its text from the snapshot); throws CompileError at `from` (the
+    // import or command line) on failure, or for binary/invalid UTF-8 content or a file over
+    // `max_bytes`.
     const SourceFile& load(const std::string& path, Loc from = {}, size_t max_bytes = 16u << 20);
     const SourceFile& add(std::string path, std::string text);
     // The script on standard input, as "<stdin>" (its imports are relative to the working
@@ -87,7 +100,9 @@ public:
     }
 
 private:
+    std::string read(const std::string& path, Loc from, size_t max_bytes);
     std::deque<std::unique_ptr<SourceFile>> files_;
+    std::shared_ptr<SourceSnapshot> snapshot_;
 };
 
 }  // namespace sdfc

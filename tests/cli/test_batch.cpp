@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <fstream>
 #include <set>
 
 #include "run.hpp"
@@ -163,4 +164,41 @@ TEST_CASE("render --tiles bands and sdfc merge make the one-render picture, byte
     CHECK(self.status == 1);
     CHECK(self.err == "sdfc: error: cannot write '" + dir + "/part0.exr': it is one of the bands merged ('" + dir + "/part0.exr')\n");
     CHECK_FALSE(fs::exists(dir + "/x.png"));
+}
+
+TEST_CASE("a batch's outputs, every frame's and every side file, are checked against each other and every input before any work") {
+    const std::string d = fresh_dir("batch_inputs");
+    auto write = [&](const std::string& name, const std::string& text) { std::ofstream(d + "/" + name, std::ios::binary) << text; };
+    const std::string in_d = "cd " + q(d) + " &&";  // (run_sdfc's prefix)
+    write("y.sdf", "render(width = 16, height = 12);\nsphere(1);\n");
+    write("xy.png", "render(width = 16, height = 12);\nsphere(1);\n");  // a script named like a picture
+    // One scene's picture onto another scene of the batch: refused, in either order.
+    for (const std::string scenes : {"xy.png y.sdf", "y.sdf xy.png"}) {
+        auto r = run_sdfc("render " + scenes + " -o 'x{name}.png' -q", in_d);
+        CHECK(r.status == 1);
+        CHECK(r.err == "sdfc: error: cannot write 'xy.png': it is the scene file 'xy.png'\n");
+        CHECK(test::slurp(d + "/xy.png") == "render(width = 16, height = 12);\nsphere(1);\n");
+    }
+    // Onto a file another scene imports.
+    write("part.png", "def part() = sphere(1);\n");
+    write("a.sdf", "import \"part.png\";\nrender(width = 16, height = 12);\npart();\n");
+    write("part.sdf", "render(width = 16, height = 12);\nbox(1);\n");
+    auto r = run_sdfc("render a.sdf part.sdf -o '{name}.png' -q", in_d);
+    CHECK(r.status == 1);
+    CHECK(r.err == "sdfc: error: cannot write 'part.png': a scene imports it ('part.png')\n");
+    CHECK(!fs::exists(d + "/a.png"));
+    // A side file onto another scene's picture.
+    r = run_sdfc("render y.sdf y.depth.sdf -o '{name}.png' --aov depth -q", in_d);
+    CHECK(r.status == 2);
+    CHECK(r.err == "sdfc: error: the depth side file of 'y.sdf' and 'y.depth.sdf' would both be written to 'y.depth.png'\n");
+    // Every frame's output is checked, not the first and last only.
+    fs::create_directories(d + "/f2.png");
+    r = run_sdfc("render y.sdf --frames 0:4 -o 'f{frame}.png' -q", in_d);
+    CHECK(r.status == 1);
+    CHECK(r.err == "sdfc: error: cannot write 'f2.png': Is a directory\n");
+    CHECK(!fs::exists(d + "/f0.png"));
+    // A zero-padded width of two digits.
+    r = run_sdfc("render y.sdf --frames 7:7 -o 'g{frame:010d}.png' -q", in_d);
+    CHECK(r.status == 0);
+    CHECK(fs::exists(d + "/g0000000007.png"));
 }

@@ -106,7 +106,7 @@ TEST_CASE("flag --max-ops") {
 
 TEST_CASE("flag --max-nesting") {
     std::string s = test::write_temp("lim_nest.sdf", "sphere(" + repeat("(", 1100) + "1" + repeat(")", 1100) + ");\n");
-    CHECK(check(s) == std::pair<int, std::string>{1, s + ":1:1031: error: nesting deeper than 1024 levels (raise it with --max-nesting)"});
+    CHECK(check(s) == std::pair<int, std::string>{1, s + ":1:1032: error: nesting deeper than 1024 levels (raise it with --max-nesting)"});
     CHECK(check(s, "--max-nesting 2000").first == 0);
     CHECK(check(s, "--max-nesting 100000").second == "sdfc: error: --max-nesting must be from 1 to 10000, not 100000");
 }
@@ -124,13 +124,13 @@ TEST_CASE("100,000 nested parentheses, blocks, minus signs, calls or modifiers s
         bool fits_asan, fits_tsan; // 10,000 levels fit the parser's stack in that sanitizer build
     };
     const std::vector<Case> cases{
-        {"nest_parens.sdf", "sphere(" + repeat("(", n) + "1" + repeat(")", n) + ");\n", "1:1031", "1:10007", false, true},
-        {"nest_blocks.sdf", repeat("{", n) + "sphere(1);" + repeat("}", n) + "\n", "1:1025", "1:10001", true, false},
-        {"nest_minus.sdf", "sphere(" + repeat("-", n) + "1);\n", "1:1031", "1:10007", true, true},
-        {"nest_calls.sdf", "def f(x) = x;\nsphere(" + repeat("f(", n) + "1" + repeat(")", n) + ");\n", "2:2054", "2:20006",
+        {"nest_parens.sdf", "sphere(" + repeat("(", n) + "1" + repeat(")", n) + ");\n", "1:1032", "1:10008", false, true},
+        {"nest_blocks.sdf", repeat("{", n) + "sphere(1);" + repeat("}", n) + "\n", "1:1026", "1:10002", true, false},
+        {"nest_minus.sdf", "sphere(" + repeat("-", n) + "1);\n", "1:1032", "1:10008", true, true},
+        {"nest_calls.sdf", "def f(x) = x;\nsphere(" + repeat("f(", n) + "1" + repeat(")", n) + ");\n", "2:2056", "2:20008",
          false, false},
         // Each modifier is one level, and its argument list one more while it is read.
-        {"nest_modifiers.sdf", repeat("translate([0,0,0]) ", n) + "sphere(1);\n", "1:19430", "1:189974", true, true},
+        {"nest_modifiers.sdf", repeat("translate([0,0,0]) ", n) + "sphere(1);\n", "1:19449", "1:189993", true, true},
     };
     for (const auto& c : cases) {
         INFO(c.file);

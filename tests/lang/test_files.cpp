@@ -115,6 +115,22 @@ TEST_CASE("a let both defined and imported is an error in either order, but a li
     CHECK(d.errors("two_libs.sdf").empty());
 }
 
+TEST_CASE("managers sharing a snapshot read each file once: the frames of a batch see one version of a script") {
+    Folder d;
+    d.write("lib.sdf", "def r() = 1;\n");
+    const std::string main = d.write("main.sdf", "import \"lib.sdf\";\nsphere(r());\n");
+    auto snapshot = std::make_shared<SourceSnapshot>();
+    auto dist = [&](SourceManager& sm) { return test::dist(compile_scene(load_scene(sm, main)), 0, 0, 0); };
+    SourceManager first(snapshot);
+    CHECK(dist(first) == Approx(-1));
+    d.write("lib.sdf", "def r() = 2;\n");  // saved during the batch
+    SourceManager later(snapshot);
+    CHECK(dist(later) == Approx(-1));
+    CHECK(later.paths() == std::vector<std::string>{main, d.path("lib.sdf")});
+    SourceManager alone;  // (a new run reads the file again)
+    CHECK(dist(alone) == Approx(-2));
+}
+
 TEST_CASE("import cycles are errors at the import that closes them") {
     Folder d;
     d.write("a.sdf", "import \"b.sdf\";\nsphere(1);\n");
