@@ -178,4 +178,18 @@ void read_points(const std::string& path, size_t max_bytes, std::vector<float>& 
     }
 }
 
+void check_2d_render(const std::string& scene, const Overrides& ov, const PictureAsks& asks, bool warn) {
+    const char* flag = asks.tiles ? "--tiles" : asks.aovs ? "--aov" : asks.alpha ? "--alpha on" : asks.steps ? "--view steps" : nullptr;
+    if (flag)
+        throw UsageError(fmt::format("{}: '{}' is a 2D model, rendered whole as its sign image (white inside, black outside): "
+                                     "no bands, AOVs, alpha or step view",
+                                     flag, scene));
+    std::string unused;
+    for (const auto& [k, v] : ov)
+        if (v && k != "--width" && k != "--height") unused += (unused.empty() ? "" : ", ") + k;
+    if (warn && !unused.empty())
+        std::fprintf(stderr, "sdfc: warning: '%s' is a 2D model, rendered as its sign image: %s change nothing\n", scene.c_str(),
+                     unused.c_str());
+}
+
 }  // namespace sdfc::cli

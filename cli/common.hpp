@@ -87,6 +87,14 @@ Overrides read_overrides(Args& a);
 // Sets them on a compiled scene; the picture's size checked against --max-pixels.
 void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c);
 
+// A 2D model (a .vm of x and y only) renders whole as its sign image: --tiles, --aov,
+// --alpha on and --view steps are a UsageError naming the first given; `warn` prints which
+// scene flags (camera, samples, shading) change nothing.
+struct PictureAsks {
+    bool tiles = false, aovs = false, alpha = false, steps = false;
+};
+void check_2d_render(const std::string& scene, const Overrides& ov, const PictureAsks& asks, bool warn);
+
 int cmd_mesh(Args& a);
 // `sdfc bench` (bench_command.cpp): renders timed, one line of figures.
 int cmd_bench(Args& a);

@@ -268,6 +268,7 @@ int cmd_render(Args& a) {
         }
     };
     check_outputs(true);
+    const PictureAsks asks{bands.has_value(), !ro.aovs.empty(), alpha && ro.alpha, ro.view == RenderView::Steps};
     float base_time = time_s ? Args::to_float("--time", *time_s) : 0.0f;
     // Every scene and import is read once, for all frames (a save during the batch waits
     // for the next run).
@@ -306,7 +307,7 @@ int cmd_render(Args& a) {
             for (int f = f0; f <= f1; ++f) {
                 if (!todo(i, f)) continue;
                 SourceManager sm(snapshot);
-                (void)compile_frame(sm, scenes[i], f);
+                if (compile_frame(sm, scenes[i], f).is_2d) check_2d_render(scenes[i], ov, asks, false);
             }
     if (my_items > 1) {
         for (const auto& [path, text] : snapshot->texts) inputs.add(path, false);
@@ -349,6 +350,7 @@ int cmd_render(Args& a) {
                     bar = true;
                 };
             }
+            if (cs.is_2d) check_2d_render(path, ov, asks, !quiet && f == f0);
             if (!quiet && f == f0)  // once per scene
                 if (const std::string why = view_problem(cs); !why.empty()) std::fprintf(stderr, "sdfc: warning: %s\n", why.c_str());
             auto t0 = std::chrono::steady_clock::now();

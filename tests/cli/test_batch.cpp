@@ -140,6 +140,11 @@ TEST_CASE("render --tiles bands and sdfc merge make the one-render picture, byte
             for (const char* side : {"depth", "normal"})
                 CHECK(test::slurp(dir + "/merged." + side + ".png") == test::slurp(dir + "/one." + side + ".png"));
     }
+    // One band of one (a cluster script with N = 1): merge takes it.
+    REQUIRE(run_sdfc("render " + q(s) + size + " --aov depth,normal --tiles 0/1 -o " + q(dir + "/only.exr")).status == 0);
+    auto only = run_sdfc("merge " + q(dir + "/only.exr") + " -o " + q(dir + "/only.png"));
+    CHECK(only.err == "sdfc: wrote " + dir + "/only.png (50x70 from 1 band)\n");
+    CHECK(test::slurp(dir + "/only.png") == test::slurp(dir + "/one.png"));
     // What merge refuses, and what --tiles does.
     CHECK(run_sdfc("merge " + q(dir + "/part0.exr") + " " + q(dir + "/part2.exr") + " -o " + q(dir + "/x.png")).err.find("are in none of the bands") !=
           std::string::npos);
@@ -201,4 +206,28 @@ TEST_CASE("a batch's outputs, every frame's and every side file, are checked aga
     r = run_sdfc("render y.sdf --frames 7:7 -o 'g{frame:010d}.png' -q", in_d);
     CHECK(r.status == 0);
     CHECK(fs::exists(d + "/g0000000007.png"));
+}
+
+TEST_CASE("a 2D model renders whole: --tiles, --aov, --alpha on and --view steps are refused, unused scene flags named") {
+    const std::string d = fresh_dir("model_2d");
+    const std::string vm = d + "/disc.vm";
+    std::ofstream(vm) << "_0 var-x\n_1 var-y\n_2 square _0\n_3 square _1\n_4 add _2 _3\n_5 const 0.5\n_6 sub _4 _5\n";
+    const std::string sphere = test::write_temp("model_2d_sphere.sdf", "sphere(1);\n");
+    const std::string size = " --width 32 --height 32 ";
+    const std::string what = "' is a 2D model, rendered whole as its sign image (white inside, black outside): no bands, AOVs, alpha or step view\n";
+    const std::vector<std::pair<std::string, std::string>> asks{
+        {"--tiles 0/2", "--tiles"}, {"--aov depth", "--aov"}, {"--alpha on", "--alpha on"}, {"--view steps", "--view steps"}};
+    for (const auto& [flag, named] : asks) {
+        INFO(flag);
+        // (in a batch, before the other scene's picture is written; --tiles takes one scene)
+        const bool tiles = named == "--tiles";
+        auto r = run_sdfc("render " + (tiles ? std::string() : q(sphere) + " ") + q(vm) + size + flag + " -o " +
+                          q(d + (tiles ? "/b.exr" : "/{name}.png")));
+        CHECK(r.status == 2);
+        CHECK(r.err == "sdfc: error: " + named + ": '" + vm + what);
+    }
+    CHECK(frames_of(d) == std::set<std::string>{"disc.vm"});
+    auto r = run_sdfc("render " + q(vm) + size + "--samples 4 --fov 30 -o " + q(d + "/disc.png"));
+    CHECK(r.status == 0);
+    CHECK(r.err.rfind("sdfc: warning: '" + vm + "' is a 2D model, rendered as its sign image: --samples, --fov change nothing\n", 0) == 0);
 }

@@ -322,7 +322,8 @@ Image oiio_read_image(const std::string& path) {
     }
     const OIIO::ImageSpec spec = in->spec();
     const int w = spec.width, h = spec.height, nch = spec.nchannels;
-    const bool band = spec.y != 0 || spec.full_height != spec.height;  // a data window: a band (--tiles)
+    // A data window, or a picture's hash (the only band, --tiles 0/1): a band (--tiles).
+    const bool band = spec.y != 0 || spec.full_height != spec.height || !spec.get_string_attribute("sdfc:picture").empty();
     if (band && (spec.x != 0 || spec.full_x != 0 || spec.full_y != 0 || spec.full_width != w || spec.y < 0 || spec.y + h > spec.full_height))
         throw std::runtime_error("cannot read '" + path + "': its data window is not a band of whole rows of its picture");
     std::vector<float> buf(static_cast<size_t>(w) * h * nch);
