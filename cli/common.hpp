@@ -17,7 +17,8 @@ namespace sdfc::cli {
 
 struct Common {
     InterpretOptions interp;
-    long max_pixels = 268'435'456;  // width * height * samples
+    long max_pixels = 268'435'456;  // width * height * samples, of one band of `bands` (render --tiles)
+    int bands = 1;
     int max_frames = 100000;
     // build() leaves the Scene to the process's exit (or the next build) instead of freeing
     // it: for commands that do little after the build (check), whose time its teardown is.

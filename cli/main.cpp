@@ -136,10 +136,11 @@ void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
         std::string why = camera_problem(cs.camera);
         if (!why.empty()) throw UsageError("--camera-position/--camera-target: " + why);
     }
-    double px = double(cs.render.width) * cs.render.height * cs.render.samples;
-    if (px > double(c.max_pixels)) {
-        std::string msg = fmt::format("{}x{} pixels at {} samples is over the limit of {} (raise it with --max-pixels)",
-                                      cs.render.width, cs.render.height, cs.render.samples, c.max_pixels);
+    const double rows = std::ceil(double(cs.render.height) / c.bands);  // (a band: about its share)
+    if (double(cs.render.width) * rows * cs.render.samples > double(c.max_pixels)) {
+        const std::string band = c.bands > 1 ? fmt::format(" ({} rows a band of {})", rows, c.bands) : "";
+        std::string msg = fmt::format("{}x{} pixels at {} samples{} is over the limit of {} (raise it with --max-pixels)",
+                                      cs.render.width, cs.render.height, cs.render.samples, band, c.max_pixels);
         // The script's render(...) chose the size: point at it.
         if (!sized && cs.render.loc.known()) throw CompileError(cs.render.loc, msg);
         throw UsageError(msg);
@@ -186,6 +187,7 @@ int cmd_render(Args& a) {
     if (bands) {
         if (ext != ".exr") throw UsageError("--tiles writes a band of the picture as exr (for sdfc merge): -o PART.exr");
         ro.band = bands->first, ro.bands = bands->second;
+        c.bands = bands->second;
     }
     ro.alpha = ext == ".exr" && !bands;  // a band holds what the merged picture will: alpha if asked
     if (alpha) {

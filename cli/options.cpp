@@ -212,7 +212,7 @@ const std::vector<Option>& scene_options() {
             lim("--max-ops", l.max_ops, "IR nodes"),
             Option{"--max-file-size", "", "BYTES", "", fmt::format("{}", l.max_file_bytes), "bytes of one source file"},
             lim("--max-nesting", l.max_nesting, "syntax nesting; a modifier and its block count 2"),
-            lim("--max-pixels", 268435456, "width * height * samples"),
+            lim("--max-pixels", 268435456, "width * height * samples (of one band: --tiles)"),
             lim("--max-frames", 100000, "frames of one --frames range"),
         };
     }();

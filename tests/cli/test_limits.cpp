@@ -199,6 +199,14 @@ TEST_CASE("flag --max-pixels (width x height x samples) and --max-frames, no out
     r = run_sdfc("render '" + s + "' -o '" + out + "' --quiet --width 20 --height 10 --samples 1 --max-pixels 200");
     CHECK(r.status == 0);
     CHECK(fs::exists(out));
+    // With --tiles I/N the limit is one band's: height / N rows.
+    const std::string band = test::temp_dir() + "/lim_band.exr";
+    r = run_sdfc("render '" + s + "' -o '" + band + "' --quiet --width 64 --height 64 --samples 1 --tiles 0/2 --max-pixels 2000");
+    CHECK(r.status == 2);
+    CHECK(first_line(r.err) == "sdfc: error: 64x64 pixels at 1 samples (32 rows a band of 2) is over the limit of 2000 (raise it with --max-pixels)");
+    r = run_sdfc("render '" + s + "' -o '" + band + "' --quiet --width 64 --height 64 --samples 1 --tiles 0/4 --max-pixels 2000");
+    CHECK(r.status == 0);
+    CHECK(fs::exists(band));
 
     std::string pattern = test::temp_dir() + "/lim_frame_{frame:04d}.png";
     r = run_sdfc("render '" + s + "' -o '" + pattern + "' --quiet --width 8 --height 8 --frames 0:9 --max-frames 5");
