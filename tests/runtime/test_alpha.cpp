@@ -101,7 +101,10 @@ TEST_CASE("8-bit files hold straight colour with alpha, hdr has none, its side f
     CHECK(px[(16 * 48 + 24) * 4 + 3] == 255);
     CHECK(px[(16 * 48 + 24) * 4 + 0] == uint8_t(std::lround(linear_to_srgb(img.at(24, 16, 0)) * 255)));
     CHECK_THROWS_WITH(write_image((dir / "a.hdr").string(), img),
-                      "cannot write '" + (dir / "a.hdr").string() + "': hdr has no alpha channel (use exr or png)");
+                      "cannot write '" + (dir / "a.hdr").string() + "': hdr has no alpha channel (exr, png, tif and tga have)");
+    CHECK_THROWS_WITH(write_image((dir / "a.jpg").string(), img),
+                      "cannot write '" + (dir / "a.jpg").string() + "': jpg has no alpha channel (exr, png, tif and tga have)");
+    CHECK(!fs::exists(dir / "a.jpg"));
 
     // Beside a float picture, the AOV side files are EXR with the planes' own values.
     RenderOptions f;
@@ -136,6 +139,6 @@ TEST_CASE("pgm is grey: the colour's luminance, one channel, and no alpha", "[im
     CHECK(px[16 * 48 + 24] != px[0]);  // the sphere against the background
     RenderOptions o;
     o.alpha = true;
-    CHECK_THROWS_WITH(write_image(pgm, render(c->cs, o)), "cannot write '" + pgm + "': pgm has no alpha channel (use png or exr)");
+    CHECK_THROWS_WITH(write_image(pgm, render(c->cs, o)), "cannot write '" + pgm + "': pgm has no alpha channel (exr, png, tif and tga have)");
     fs::remove_all(dir);
 }

@@ -275,8 +275,11 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
     const int oc = nc == 2 ? 1 : nc;  // no grey+alpha
     std::vector<std::string> names(kRGBA, kRGBA + oc);
     if (oc == 1) names = {"Y"};
+    // Alpha goes where render --alpha on may write it (cli/main.cpp), for merge's bands and
+    // the APIs' pictures too: a jpg or bmp writer would drop it, or take it for CMYK.
+    if (oc == 4 && ext != ".png" && ext != ".tif" && ext != ".tiff" && ext != ".tga")
+        throw std::runtime_error("cannot write '" + path + "': " + ext.substr(1) + " has no alpha channel (exr, png, tif and tga have)");
     if (is_float_format(ext)) {
-        if (nc == 4) throw std::runtime_error("cannot write '" + path + "': " + ext.substr(1) + " has no alpha channel (use exr or png)");
         const int fc = ext == ".hdr" ? 3 : oc;  // RGBE is always RGB
         std::vector<std::string> fnames(kRGBA, kRGBA + fc);
         std::vector<float> buf(n * fc);
@@ -288,8 +291,6 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
         write_atomic(path, as, img.width, img.height, fnames, OIIO::TypeDesc::FLOAT, buf.data(), true);
         return;
     }
-    if ((ext == ".pgm" || ext == ".ppm" || ext == ".pnm" || ext == ".pbm") && oc == 4)
-        throw std::runtime_error("cannot write '" + path + "': " + ext.substr(1) + " has no alpha channel (use png or exr)");
     if (ext == ".pgm" && oc == 3) {
         // Grey: the luminance (Rec. 709) of the linear colour, sRGB-encoded.
         std::vector<uint8_t> grey(n);
