@@ -96,6 +96,10 @@ struct PictureAsks {
 };
 void check_2d_render(const std::string& scene, const Overrides& ov, const PictureAsks& asks, bool warn);
 
+// The format -o OUT (or --format) names, checked ("" when the extension says it).
+std::string image_format_flag(const std::string& out, const std::optional<std::string>& format);
+// `sdfc render` (render_command.cpp).
+int cmd_render(Args& a);
 int cmd_mesh(Args& a);
 // `sdfc bench` (bench_command.cpp): renders timed, one line of figures.
 int cmd_bench(Args& a);
