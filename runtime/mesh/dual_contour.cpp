@@ -164,6 +164,8 @@ void place_vertices(const Grid& g, Brick& b, Scratch& s) {
     }
     b.verts.clear();
     b.cell_of.clear();
+    std::vector<uint32_t> shared;  // the first vertex of each cell with several
+    std::vector<glm::vec3> mass;   // per vertex: the middle of its sheet's crossings
     for (int z = 0; z < kB; ++z)
         for (int y = 0; y < kB; ++y)
             for (int x = 0; x < kB; ++x) {
@@ -175,20 +177,39 @@ void place_vertices(const Grid& g, Brick& b, Scratch& s) {
                 const glm::ivec3 cell = b.at * kB + glm::ivec3(x, y, z);
                 glm::vec3 lo, hi;
                 vertex_box(g, cell, lo, hi);
+                if (pt.count > 1) shared.push_back(b.vbase[ci]);
                 for (int q = 0; q < pt.count; ++q) {
                     Qef qef;
+                    glm::vec3 sum(0.0f);
+                    int n = 0;
                     for (int e = 0; e < 12; ++e) {
                         if (pt.of_edge[e] != q) continue;
                         const int c0 = edge_corners(e)[0];
                         const int slot = (e / 4) * kC3 + corner_index(x + (c0 & 1), y + ((c0 >> 1) & 1), z + ((c0 >> 2) & 1));
                         const int i = slot_of[size_t(slot)];
-                        if (i >= 0) qef.add(at[size_t(i)], normal[size_t(i)]);
+                        if (i >= 0) qef.add(at[size_t(i)], normal[size_t(i)]), sum += at[size_t(i)], ++n;
                     }
                     b.verts.push_back(glm::vec3(qef.solve_in(glm::dvec3(lo), glm::dvec3(hi))));
                     b.cell_of.push_back(cell);
+                    mass.push_back(n > 0 ? sum / float(n) : b.verts.back());
                 }
             }
     settle_vertices(g, b, s);
+    // A cell with two sheets (or more) whose vertices met (both planes' corner clamped to one
+    // point of the cell's box, or settled onto one point) would pinch the mesh there: an STL
+    // has no indices, so a reader merges them. Each moves a quarter of the way to the middle
+    // of its own sheet's crossings.
+    for (const uint32_t first : shared) {
+        const glm::ivec3 cell = b.cell_of[first];
+        uint32_t end = first;
+        while (end < b.verts.size() && b.cell_of[end] == cell) ++end;
+        glm::vec3 lo, hi;
+        vertex_box(g, cell, lo, hi);
+        for (uint32_t i = first; i < end; ++i)
+            for (uint32_t j = i + 1; j < end; ++j)
+                if (glm::distance(b.verts[i], b.verts[j]) < 1e-3f * h)
+                    for (const uint32_t k : {i, j}) b.verts[k] = glm::clamp(glm::mix(b.verts[k], mass[k], 0.25f), lo, hi);
+    }
 }
 
 // ------------------------------------------------------------------ faces

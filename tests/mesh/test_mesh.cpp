@@ -185,6 +185,18 @@ TEST_CASE("mesh: a plate thinner than a cell and a gyroid ball stay closed and m
     check_closed_manifold(r.m);
 }
 
+TEST_CASE("mesh: a cell's two sheets keep two positions (an STL reader merges equal ones)", "[mesh]") {
+    // examples/gyroid-ball.sdf's field at 48 and 64 cells: 6 and 12 such pairs met at one point.
+    for (const int res : {48, 64}) {
+        INFO(res);
+        Meshed g = mesh_text("intersection { sphere(1); gyroid(0.5, 0.05); }", res);
+        check_closed_manifold(g.m);
+        std::set<std::array<float, 3>> at;
+        for (const glm::vec3& v : g.m.positions) at.insert({v.x, v.y, v.z});
+        CHECK(at.size() == g.m.positions.size());
+    }
+}
+
 TEST_CASE("mesh: the box cuts the solid and closes it with a lid", "[mesh]") {
     auto c = compile_text("plane([0, 1, 0], 0);");
     mesh::MeshOptions o;
