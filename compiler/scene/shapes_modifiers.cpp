@@ -63,17 +63,25 @@ Bounds turned(const Bounds& c, int axis) {
 // its own cell (a larger child is cut beyond that).
 constexpr int kRepeatReach = 2;
 
-// The copies of polar_repeat(n) whose child (bounds `b`, copy 0 as given) reaches into
-// sector 0, the one centred on +x (angles atan2(z, x) in [-pi/n, pi/n]): offsets j such
-// that the child turned by j sectors overlaps it. 0 first; at most 2 * kRepeatReach + 1.
-std::vector<int> polar_neighbours(const Bounds& b, float n) {
+// polar_repeat(n)'s sectors, centred on its child's direction `centre` (an angle atan2(z, x):
+// copy 0 of the child as given), and the copies whose child reaches into sector 0 (angles
+// within pi/n of the centre): offsets j, 0 first, at most 2 * kRepeatReach + 1. `floor`:
+// the child's angular extent [a0, a1] when it is away from the axis and every copy that
+// reaches in was taken, so the copies left out are at least that far round.
+struct PolarCopies {
+    float centre = 0.0f, a0 = 0.0f, a1 = 0.0f;
     std::vector<int> js{0};
+    bool floor = false;
+};
+PolarCopies polar_neighbours(const Bounds& b, float n) {
+    PolarCopies pc;
     if (!(n >= 1.0f) || n != std::floor(n) || !(b.lo.x > -1e29f && b.hi.x < 1e29f && b.lo.z > -1e29f && b.hi.z < 1e29f))
-        return js;
+        return pc;
     const float ang = 2.0f * kPi / n;
     const int count = int(std::min(n, 1e6f));
     float a0, a1;  // the child's angular extent
-    if (b.lo.x <= 0 && b.hi.x >= 0 && b.lo.z <= 0 && b.hi.z >= 0) {
+    const bool around = b.lo.x <= 0 && b.hi.x >= 0 && b.lo.z <= 0 && b.hi.z >= 0;
+    if (around) {
         a0 = -kPi, a1 = kPi;  // around the axis: every direction
     } else {
         const float ac = std::atan2(0.5f * (b.lo.z + b.hi.z), 0.5f * (b.lo.x + b.hi.x));
@@ -84,9 +92,12 @@ std::vector<int> polar_neighbours(const Bounds& b, float n) {
                 d = d > kPi ? d - 2 * kPi : (d < -kPi ? d + 2 * kPi : d);
                 a0 = std::min(a0, d), a1 = std::max(a1, d);
             }
-        a0 += ac, a1 += ac;
+        pc.centre = 0.5f * (a0 + a1) + ac;
+        a0 += ac - pc.centre, a1 += ac - pc.centre;  // about the centre
     }
-    for (int dj = 1; dj <= count / 2 && int(js.size()) < 2 * kRepeatReach + 1; ++dj)
+    bool cut = false;
+    int jmin = 0, jmax = 0;
+    for (int dj = 1; dj <= count / 2; ++dj)
         for (int j : {dj, -dj}) {
             if (j == -dj && 2 * dj == count) continue;  // the same copy as +dj
             bool hit = false;
@@ -94,15 +105,31 @@ std::vector<int> polar_neighbours(const Bounds& b, float n) {
                 const float lo = a0 + float(j) * ang + float(k) * 2 * kPi, hi = a1 + float(j) * ang + float(k) * 2 * kPi;
                 hit = lo < 0.5f * ang && hi > -0.5f * ang;
             }
-            if (hit && int(js.size()) < 2 * kRepeatReach + 1) js.push_back(j);
+            if (!hit) continue;
+            if (int(pc.js.size()) >= 2 * kRepeatReach + 1) {
+                cut = true;
+                continue;
+            }
+            pc.js.push_back(j);
+            jmin = std::min(jmin, j), jmax = std::max(jmax, j);
         }
-    return js;
+    // (Those taken are one run jmin..jmax: a copy reaches in only if the ones between do.)
+    pc.floor = !around && !cut && count >= 2 && int(pc.js.size()) == jmax - jmin + 1 && int(pc.js.size()) < count;
+    pc.a0 = a0 + float(jmin) * ang, pc.a1 = a1 + float(jmax) * ang;  // what the copies taken cover
+    // (As for repeat: only where the copies left out keep a twentieth of a sector away.)
+    const float taken = ang * float(pc.js.size());
+    pc.floor = pc.floor && std::min(pc.a0 + taken - 0.5f * ang, -0.5f * ang - (pc.a1 - taken)) >= 0.05f * ang;
+    return pc;
 }
 
-// Domain repetition: the point moves into the cell of the nearest copy. A child that
-// reaches out of its cell would be cut at the cell's faces, so the copies of the
-// neighbouring cells that reach into this one are evaluated too (from the child's bounds;
-// none for a child inside its cell, the usual case). `count`: RepeatFinite's slots.
+// Domain repetition: the point moves into its cell, and the child is evaluated there. The
+// cells are centred on the child's box (an off-centre child, `repeat(v) translate(t) s`,
+// sits in the middle of its cell). A child that reaches out of its cell would be cut at the
+// cell's faces, so the copies of the neighbouring cells that reach into this one are
+// evaluated too (from the child's bounds; none for a child inside its cell, the usual case).
+// The copies left out are at least as far as their boxes: that distance is a floor under
+// the copies evaluated, so a point near a face never overestimates (a copy next door can be
+// nearer than its own). `count`: RepeatFinite's slots.
 Lowered repeat(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited, bool finite) {
     static_assert(size_t(RepeatP::period) == size_t(RepeatFiniteP::period));
     Graph& g = l.g;
@@ -111,19 +138,29 @@ Lowered repeat(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited,
     const Bounds cb = shape_bounds(g, *s.children.at(0));
     std::array<NodeId, 3> idx{kNoNode, kNoNode, kNoNode};
     std::array<int, 3> jlo{0, 0, 0}, jhi{0, 0, 0};
+    std::array<bool, 3> boxed{false, false, false};  // the floor for the copies left out applies
+    glm::vec3 mid(0.0f), lo(0.0f), hi(0.0f);          // the child's box about the cells' centres
     for (int i = 0; i < 3; ++i) {
         if (g.is_const(per[i]) && g.const_value(per[i]) == 0.0f) continue;  // axis left alone
-        idx[i] = g.unary(Op::Floor, l.add(l.div(p[i], per[i]), l.c(0.5f)));
+        const bool fits = g.is_const(per[i]) && cb.lo[i] > -1e29f && cb.hi[i] < 1e29f && g.const_value(per[i]) > 0.0f;
+        if (fits) mid[i] = 0.5f * cb.lo[i] + 0.5f * cb.hi[i], lo[i] = cb.lo[i] - mid[i], hi[i] = cb.hi[i] - mid[i];
+        const NodeId at = mid[i] == 0.0f ? p[i] : l.sub(p[i], l.c(mid[i]));
+        idx[i] = g.unary(Op::Floor, l.add(l.div(at, per[i]), l.c(0.5f)));
         if (finite) idx[i] = l.clamp(idx[i], l.neg(count(i)), count(i));
-        if (!g.is_const(per[i]) || !(cb.lo[i] > -1e29f && cb.hi[i] < 1e29f)) continue;
-        const float pe = g.const_value(per[i]), half = 0.5f * pe;  // > 0 (checked by repeat)
+        if (!fits) continue;
+        const float pe = g.const_value(per[i]), half = 0.5f * pe;
         // Copy j of the neighbours spans [lo + j pe, hi + j pe]: those overlapping
         // this cell, [-half, half]. At most kRepeatReach each side.
         // (Clamped as floats first: bounds of 1e28 over a period of 0.01 overflow an int.)
-        const float lo_j = std::floor((-half - cb.hi[i]) / pe) + 1, hi_j = std::ceil((half - cb.lo[i]) / pe) - 1;
-        if (!(pe > 0) || !std::isfinite(lo_j) || !std::isfinite(hi_j)) continue;
+        const float lo_j = std::floor((-half - hi[i]) / pe) + 1, hi_j = std::ceil((half - lo[i]) / pe) - 1;
+        if (!std::isfinite(lo_j) || !std::isfinite(hi_j)) continue;
         jlo[i] = int(std::clamp(lo_j, float(-kRepeatReach), 0.0f));
         jhi[i] = int(std::clamp(hi_j, 0.0f, float(kRepeatReach)));
+        // (Only where the copies left out keep a twentieth of a period from this cell: boxes
+        // that fill their cells, a lattice's struts, would floor the distance to 0 on every
+        // face. Such a child is its cell's nearest copy when it is symmetric, as they are.)
+        const float gap = std::min(lo[i] + float(jhi[i] + 1) * pe - half, -half - hi[i] - float(jlo[i] - 1) * pe);
+        boxed[i] = std::isfinite(gap) && gap >= 0.05f * pe;
     }
     std::optional<Lowered> acc;  // the copies are one child: one Lipschitz bound
     for (int jx = jlo[0]; jx <= jhi[0]; ++jx)
@@ -143,6 +180,32 @@ Lowered repeat(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited,
                 Lowered r = child(l, s, q, inherited);
                 acc = acc ? nearer(l, *acc, r, inherited) : r;
             }
+    // The floor: along a boxed axis, the copies past the last one evaluated each side (those
+    // that exist: a finite repeat has none past its ends), no nearer than their boxes; along
+    // the other axes no nearer than the child's box (in its own cell where repeated: the
+    // nearest box there when the child fits it).
+    std::array<NodeId, 3> u{kNoNode, kNoNode, kNoNode}, gap{kNoNode, kNoNode, kNoNode};
+    for (int i = 0; i < 3; ++i) {
+        const bool own = boxed[i] && jlo[i] == 0 && jhi[i] == 0;
+        if (boxed[i]) u[i] = l.sub(l.sub(p[i], l.c(mid[i])), l.mul(per[i], idx[i]));  // in [-half, half] but past a finite end
+        if (own) gap[i] = l.mx(l.mx(l.sub(l.c(lo[i]), u[i]), l.sub(u[i], l.c(hi[i]))), l.c(0.0f));
+        else if (idx[i] == kNoNode && cb.lo[i] > -1e29f && cb.hi[i] < 1e29f)
+            gap[i] = l.mx(l.mx(l.sub(l.c(cb.lo[i]), p[i]), l.sub(p[i], l.c(cb.hi[i]))), l.c(0.0f));
+    }
+    NodeId floor = kNoNode;
+    for (int i = 0; i < 3; ++i) {
+        if (!boxed[i]) continue;
+        const float pe = g.const_value(per[i]);
+        NodeId above = l.sub(l.c(lo[i] + float(jhi[i] + 1) * pe), u[i]), below = l.sub(u[i], l.c(hi[i] + float(jlo[i] - 1) * pe));
+        if (finite) {
+            above = l.sel(l.lt(l.add(idx[i], l.c(float(jhi[i]))), count(i)), above, l.c(1e30f));
+            below = l.sel(l.lt(l.neg(count(i)), l.add(idx[i], l.c(float(jlo[i])))), below, l.c(1e30f));
+        }
+        const int k1 = (i + 1) % 3, k2 = (i + 2) % 3;
+        const NodeId side = l.len3(l.mn(above, below), gap[k1] == kNoNode ? l.c(0.0f) : gap[k1], gap[k2] == kNoNode ? l.c(0.0f) : gap[k2]);
+        floor = floor == kNoNode ? side : l.mn(floor, side);
+    }
+    if (floor != kNoNode) acc->d = l.mn(acc->d, floor);
     return *acc;
 }
 
@@ -221,21 +284,35 @@ Bounds bounds_RepeatFinite(const BoundsIn& b) {
 }
 
 Lowered lower_PolarRepeat(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited) {
-    // hg_sdf pModPolar around y; copy 0 points along +x. As for repeat, the copies of the
-    // neighbouring sectors that reach into this one are evaluated too.
+    // hg_sdf pModPolar around y, its sectors centred on the child's direction (copy 0 as
+    // given). As for repeat, the copies of the neighbouring sectors that reach into this one
+    // are evaluated too, and those left out are a floor: a point at radius r, an angle d from
+    // their sectors, is at least r sin(min(d, pi / 2)) away.
     Graph& g = l.g;
     NodeId n = P(s, PolarRepeatP::n);
     NodeId ang = l.div(l.c(2 * kPi), n);
-    NodeId a = l.add(g.binary(Op::Atan2, p[2], p[0]), l.mul(ang, l.c(0.5f)));
+    PolarCopies pc;
+    if (g.is_const(n)) pc = polar_neighbours(shape_bounds(g, *s.children.at(0)), g.const_value(n));
+    const NodeId centre = l.c(pc.centre);
+    NodeId a = l.add(l.sub(g.binary(Op::Atan2, p[2], p[0]), centre), l.mul(ang, l.c(0.5f)));
     NodeId r = l.len2(p[0], p[2]);
-    a = l.sub(g.binary(Op::Mod, a, ang), l.mul(ang, l.c(0.5f)));
-    std::vector<int> js{0};
-    if (g.is_const(n)) js = polar_neighbours(shape_bounds(g, *s.children.at(0)), g.const_value(n));
+    a = l.sub(g.binary(Op::Mod, a, ang), l.mul(ang, l.c(0.5f)));  // about the centre
     std::optional<Lowered> acc;
-    for (int j : js) {
-        NodeId aj = j == 0 ? a : l.sub(a, l.mul(ang, l.c(float(j))));
+    for (int j : pc.js) {
+        NodeId aj = l.add(j == 0 ? a : l.sub(a, l.mul(ang, l.c(float(j)))), centre);
         Lowered c = child(l, s, {l.mul(g.unary(Op::Cos, aj), r), p[1], l.mul(g.unary(Op::Sin, aj), r)}, inherited);
         acc = acc ? nearer(l, *acc, c, inherited) : c;
+    }
+    if (pc.floor) {
+        const float step = 2 * kPi / g.const_value(n);
+        // Round from a to the next copy left out either way, at most a quarter turn.
+        const NodeId above = l.sub(l.c(pc.a0 + step * float(pc.js.size())), a), below = l.sub(a, l.c(pc.a1 - step * float(pc.js.size())));
+        const NodeId d = l.clamp(l.mn(above, below), l.c(0.0f), l.c(0.5f * kPi));
+        const Bounds cb = shape_bounds(g, *s.children.at(0));  // (and no nearer than its height)
+        const NodeId dy = cb.lo.y > -1e29f && cb.hi.y < 1e29f
+                              ? l.mx(l.mx(l.sub(l.c(cb.lo.y), p[1]), l.sub(p[1], l.c(cb.hi.y))), l.c(0.0f))
+                              : l.c(0.0f);
+        acc->d = l.mn(acc->d, l.len2(l.mul(r, g.unary(Op::Sin, d)), dy));
     }
     return *acc;
 }

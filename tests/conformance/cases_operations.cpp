@@ -109,11 +109,16 @@ void add_operation_cases(std::vector<Case>& out) {
     s.script("repeat(2, 1) sphere(0.5);").at(2, 2, -2, -0.5).at(4, 0, 0, 1.5);  // index 1 present, index 2 absent
     s.script("repeat([2, 0, 0], [2, 0, 0]) sphere(0.5);").at(-4, 0, 0, -0.5).at(6, 0, 0, 1.5).at(0, 2, 0, 1.5);
 
-    // A child that reaches out of its cell is whole: the copies of the neighbouring cells that
-    // reach into a cell are evaluated there too. Finite: copies at 0.9 + 2k for k = -2..2.
+    // Cells are centred on the child: an off-centre child is whole, and a point by its cell's
+    // face sees the copy next door (-0.99: the copy at -1.15, not its own at 0.85). The copies
+    // left out are a floor under the distance: exact near the surface, a bound further out.
+    // Finite: copies at 0.9 + 2k for k = -2..2.
     std::vector<std::array<double, 3>> fc;
     for (int k = -2; k <= 2; ++k) fc.push_back({0.9 + 2.0 * k, 0, 0});
-    s.script("repeat([2, 0, 0], 2) translate([0.9, 0, 0]) sphere(0.5);", 6).at(1.3f, 0, 0, -0.1f).random(spheres(fc, 0.5), 6, 300, 1e-4, 99);
+    const auto far = [](const ShapeCases::Ref& ref) { return [ref](double x, double y, double z) { return ref(x, y, z) > 0.3; }; };
+    s.script("repeat([2, 0, 0], 2) translate([0.9, 0, 0]) sphere(0.5);", 6).at(1.3f, 0, 0, -0.1f).random_bound(spheres(fc, 0.5), far(spheres(fc, 0.5)), 1e-4, 6, 300, 99, 1e-4);
+    s.script("repeat([2, 0, 0]) translate([0.85, 0, 0]) sphere(0.1);").at(-0.99f, 0, 0, 0.06f, 1e-4).at(0.85f, 0.5f, 0, 0.4f);
+    s.script("repeat([2, 0, 0]) translate([0.45, 0, 0]) sphere(0.5);").at(-0.62f, 0, 0, 0.43f, 1e-4);
     // Infinite, on two axes, a child across a corner of its cell.
     s.script("repeat([2, 0, 2]) translate([0.8, 0, -0.8]) sphere(0.4);").at(1.15f, 0, -0.8f, -0.05f).at(0.8f, 0, -1.15f, -0.05f).at(2.8f, 0, 1.2f, -0.4f);
     // Polar: a child off copy 0's sector (+z, with 3 sectors centred on +x) is still there.
@@ -122,7 +127,9 @@ void add_operation_cases(std::vector<Case>& out) {
         const double a = M_PI / 2 + k * 2 * M_PI / 3;  // copies at angles atan2(z, x)
         pc.push_back({2 * std::cos(a), 0, 2 * std::sin(a)});
     }
-    s.script("polar_repeat(3) translate([0, 0, 2]) sphere(0.5);", 4).at(0, 0, 2, -0.5).random(spheres(pc, 0.5), 4, 300, 1e-4, 99);
+    s.script("polar_repeat(3) translate([0, 0, 2]) sphere(0.5);", 4).at(0, 0, 2, -0.5).random_bound(spheres(pc, 0.5), far(spheres(pc, 0.5)), 1e-4, 4, 300, 99, 1e-4);
+    // Sectors centred on an off-centre child: the copy next door is seen past the sector's edge.
+    s.script("polar_repeat(4) translate([1, 0, 0.5]) sphere(0.2);").at(0.764f, 0.05f, 0.791f, 0.17799f, 1e-4);
     s.script("polar_repeat(6) translate([2, 0, 0]) sphere(0.3);").at(2, 0, 0, -0.3);
 
     // symmetry mirrors the positive side onto the negative; x folds unless y or z is named.
