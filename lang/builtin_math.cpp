@@ -83,6 +83,7 @@ Value Interp::call_math(const BuiltinInfo& info, std::vector<Value>& args, const
         }
         case B::Atan:
             if (args.size() == 2) return bin(Op::Atan2);  // GLSL's atan(y, x)
+            arity(1, 2);
             return un(Op::Atan);
         case B::Atan2: return bin(Op::Atan2);
         case B::Sqrt: {

@@ -78,6 +78,12 @@ TEST_CASE("a script's own len, norm, concat, lookup or param (names the contract
     CHECK(test::first_error_line("let sin = 2; sphere(sin);") == "test.sdf:1:5: error: 'sin' is a built-in name and cannot be redefined");
 }
 
+TEST_CASE("atan takes one argument or two (GLSL's atan(y, x)), and says so") {
+    CHECK(close(dist_of("sphere(atan(1, 1) * 4);", 0, 0, 0), -3.14159265f));
+    CHECK(test::first_error_line("sphere(atan(1, 2, 3));") == "test.sdf:1:8: error: atan takes 1 to 2 arguments, not 3");
+    CHECK(test::first_error_line("sphere(atan());") == "test.sdf:1:8: error: atan takes 1 to 2 arguments, not 0");
+}
+
 TEST_CASE("if/else at statement level and ?: in expressions") {
     CHECK(close(dist_of("let r = 0.5; if (r > 0.3) sphere(r); else box(r);", 0, 0, 1), 0.5));
     CHECK(close(dist_of("let r = 0.2; if (r > 0.3) sphere(r); else box(r);", 0, 0, 1), 0.9));
