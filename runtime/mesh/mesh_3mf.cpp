@@ -47,8 +47,10 @@ std::string encode_3mf(const Mesh& m) {
     std::vector<MODELMESHTRIANGLE> t(m.triangles.size());
     for (size_t i = 0; i < t.size(); ++i)
         for (int k = 0; k < 3; ++k) t[i].m_nIndices[k] = m.triangles[i][size_t(k)];
-    check(lib3mf_meshobject_setgeometry(object.p, v.data(), DWORD(v.size()), t.data(), DWORD(t.size())), object.p,
-          "setting the geometry");
+    // (An empty mesh stays an object with no vertices: lib3mf refuses empty arrays' null data.)
+    if (!t.empty())
+        check(lib3mf_meshobject_setgeometry(object.p, v.data(), DWORD(v.size()), t.data(), DWORD(t.size())), object.p,
+              "setting the geometry");
     if (m.colors.size() == m.positions.size() && !m.colors.empty()) {
         Held props;
         check(lib3mf_meshobject_createpropertyhandler(object.p, &props.p), object.p, "adding colours");

@@ -272,6 +272,10 @@ TEST_CASE("mesh: STL, OBJ, PLY and 3MF encode what they should", "[mesh]") {
     for (size_t i = 0; i < back.positions.size(); ++i) worst = std::max(worst, glm::length(back.positions[i] - s.m.positions[i]));
     CHECK(worst < 1e-5f);
     CHECK(back.triangles == s.m.triangles);
+    // An empty mesh (a warning in sdfc mesh) is written in every format, 3MF too.
+    for (const auto f : {mesh::MeshFormat::Stl, mesh::MeshFormat::Obj, mesh::MeshFormat::Ply, mesh::MeshFormat::ThreeMf})
+        CHECK_NOTHROW(mesh::encode_mesh(mesh::Mesh{}, f));
+    CHECK(mesh::decode_3mf(mesh::encode_mesh(mesh::Mesh{}, mesh::MeshFormat::ThreeMf)).triangles.empty());
     CHECK(mesh::mesh_format("x.3MF") == mesh::MeshFormat::ThreeMf);
     CHECK(mesh::mesh_format("a/b.STL") == mesh::MeshFormat::Stl);
     CHECK(mesh::mesh_format("b.png") == mesh::MeshFormat::Unknown);
