@@ -26,7 +26,8 @@ struct Cell {
 }  // namespace
 
 // (max_cells: a level's frontier past it ends the search: no bounded solid, or a coarser box)
-bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3& lo, glm::vec3& hi, size_t max_cells) {
+bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3& lo, glm::vec3& hi, size_t max_cells, bool* nothing) {
+    if (nothing) *nothing = false;
     if (distance.outputs.empty()) return false;
     Tape tape = Tape::from(distance, 0);
     tape.link();
@@ -97,7 +98,10 @@ bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3
     }
     glm::vec3 blo = solid_lo, bhi = solid_hi;
     for (const Cell& c : frontier) grow(blo, bhi, c);
-    if (!(blo.x <= bhi.x && blo.y <= bhi.y && blo.z <= bhi.z)) return false;  // nothing: no solid
+    if (!(blo.x <= bhi.x && blo.y <= bhi.y && blo.z <= bhi.z)) {  // nothing: no solid
+        if (nothing) *nothing = true;
+        return false;
+    }
     if (glm::any(glm::lessThanEqual(blo, glm::vec3(-kSearch))) || glm::any(glm::greaterThanEqual(bhi, glm::vec3(kSearch))))
         return false;  // reaches the search cube: unbounded, or bigger than it
     lo = blo, hi = bhi;
@@ -115,7 +119,16 @@ bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float
     if (!b.finite() || !(b.lo.x <= b.hi.x && b.lo.y <= b.hi.y && b.lo.z <= b.hi.z)) {
         // The shapes do not tell (a custom field): the intervals, without the floors if any.
         const Program& p = scene.solid.outputs.empty() ? scene.distance : scene.solid;
-        if (!interval_box(p, true, time, blo, bhi, search_cells)) return false;
+        bool nothing = false;
+        if (!interval_box(p, true, time, blo, bhi, search_cells, &nothing)) {
+            const bool reads_point = std::any_of(p.code.begin(), p.code.end(), [](const Instr& in) {
+                return in.op == Op::VarX || in.op == Op::VarY || in.op == Op::VarZ;
+            });
+            if (!nothing || !reads_point) return false;  // (a constant field has no surface to find)
+            // Proved empty everywhere (an intersection of shapes apart): a box where the
+            // mesh is empty, as it is for a difference that removes all.
+            blo = glm::vec3(-1.0f), bhi = glm::vec3(1.0f);
+        }
     }
     const glm::vec3 ext = bhi - blo;
     const float longest = std::max({ext.x, ext.y, ext.z, 1e-3f});

@@ -74,6 +74,7 @@ Mesh mesh_scene(const CompiledScene& scene, const MeshOptions& o, MeshStats* sta
 // rest, which cuts a floor into a thin base), a .vm model's [-1, 1]^3. Where the scene's
 // shapes give no bounds (a custom field), the intervals find them (auto_box.cpp). False
 // when the scene is unbounded (an infinite repetition, only a plane): --bounds is needed.
+// A scene the intervals prove empty everywhere gets [-1, 1]^3 (its mesh is empty).
 // `search_cells` caps the interval search's frontier (its cost; the fuzz target keeps it small).
 // `resolution` (cells along the longest side, 0: unknown): with floors, the margin is at least
 // two cells, so the base is thick enough to be sampled.
@@ -85,6 +86,8 @@ bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float
 // cube's faces (no bounded solid) or finds nothing. A distance bound (lipschitz) is also
 // bounded by its value at each cell's centre.
 inline constexpr float kSearch = 1.0e4f;
-bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3& lo, glm::vec3& hi, size_t max_cells = 8192);
+// `nothing`: set when false because every cell was proved outside.
+bool interval_box(const Program& distance, bool lipschitz, float time, glm::vec3& lo, glm::vec3& hi, size_t max_cells = 8192,
+                  bool* nothing = nullptr);
 
 }  // namespace sdfc::mesh

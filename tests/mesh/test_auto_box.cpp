@@ -61,6 +61,11 @@ TEST_CASE("auto box: unbounded scenes have none", "[mesh]") {
     CHECK_FALSE(box_of("field (p) -> 1;").found);  // no surface anywhere
 }
 
+TEST_CASE("auto box: shapes apart intersected (nothing anywhere) get [-1, 1]^3, where the mesh is empty", "[mesh]") {
+    const Box b = box_of("intersection { translate([-2, 0, 0]) sphere(1); translate([2, 0, 0]) sphere(1); }");
+    check_holds(b, glm::vec3(-1.0f), glm::vec3(1.0f), 0.05f);  // (with the usual margin)
+}
+
 TEST_CASE("auto box: a floor moved or turned by constants is a floor too", "[mesh]") {
     // The box of the rest, as for plane(offset = -0.6): translate and rotate place the plane.
     const Box plain = box_of("sphere(1); plane([0, 1, 0], -0.6);");
