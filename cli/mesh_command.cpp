@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -91,7 +92,8 @@ int cmd_mesh(Args& a) {
     double cell_limit = double(1ull << 31);
     if (max_cells) {
         // Up to 2^36 cells (the brick map then takes 512 MB): more than an int holds.
-        cell_limit = std::floor(double(Args::to_float("--max-cells", *max_cells)));
+        (void)Args::to_float("--max-cells", *max_cells);  // (its checks of the text; the value as a double: past 2^24 a float rounds)
+        cell_limit = std::floor(std::strtod(max_cells->c_str(), nullptr));
         if (!(cell_limit >= 1.0 && cell_limit <= double(1ull << 36)))
             throw UsageError(fmt::format("--max-cells must be from 1 to {}, not {}", 1ull << 36, *max_cells));
     }

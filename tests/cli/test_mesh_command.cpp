@@ -61,6 +61,8 @@ TEST_CASE("mesh errors come before the work and change nothing") {
     CHECK(run_sdfc("mesh " + q(s) + " -o a.stl --resolution 4000").err ==
           "sdfc: error: a grid of 64384768512 cells is over the limit of 2147483648 (raise it with --max-cells)\n");
     CHECK(run_sdfc("mesh " + q(s) + " -o a.stl --max-cells 1e12").err == "sdfc: error: --max-cells must be from 1 to 68719476736, not 1e12\n");
+    CHECK(run_sdfc("mesh " + q(s) + " -o a.stl --max-cells 68719476737").err ==
+          "sdfc: error: --max-cells must be from 1 to 68719476736, not 68719476737\n");  // (not rounded as a float)
     auto raised = run_sdfc("mesh " + q(s) + " -o " + q(test::temp_dir() + "/raised.stl") + " --resolution 8 --max-cells 5e9 -q");
     CHECK(raised.status == 0);  // above the default limit and above what an int holds
     const std::string plane = test::write_temp("mesh_plane.sdf", "plane([0, 1, 0], 0);\n");
