@@ -129,6 +129,10 @@ int cmd_mesh(Args& a) {
         });
         if (!reads_point) throw std::runtime_error(fmt::format("{} has no surface (its distance is the same everywhere): nothing to mesh", path));
         throw UsageError("the scene is unbounded (a plane, an infinite repetition, shapes beyond 1e29?): give --bounds X0,Y0,Z0,X1,Y1,Z1");
+    } else if (!(glm::all(glm::lessThanEqual(glm::abs(mo.lo), glm::vec3(1e15f))) && glm::all(glm::lessThanEqual(glm::abs(mo.hi), glm::vec3(1e15f))))) {
+        // (as --bounds: beyond, a float cannot place a vertex within a cell, and squares overflow)
+        throw std::runtime_error(fmt::format("{} reaches beyond 1e15 of the origin ({} to {}): scale it down to mesh it", path,
+                                             fmt::format("{}, {}, {}", mo.lo.x, mo.lo.y, mo.lo.z), fmt::format("{}, {}, {}", mo.hi.x, mo.hi.y, mo.hi.z)));
     }
     const glm::vec3 ext = mo.hi - mo.lo;
     const float longest = std::max({ext.x, ext.y, ext.z});

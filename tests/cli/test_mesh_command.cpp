@@ -63,6 +63,11 @@ TEST_CASE("mesh errors come before the work and change nothing") {
     CHECK(run_sdfc("mesh " + q(s) + " -o a.stl --max-cells 1e12").err == "sdfc: error: --max-cells must be from 1 to 68719476736, not 1e12\n");
     CHECK(run_sdfc("mesh " + q(s) + " -o a.stl --max-cells 68719476737").err ==
           "sdfc: error: --max-cells must be from 1 to 68719476736, not 68719476737\n");  // (not rounded as a float)
+    const std::string big = test::write_temp("mesh_big.sdf", "sphere(1e20);\n");  // (its squares overflow a float)
+    auto r = run_sdfc("mesh " + q(big) + " -o a.stl");
+    CHECK(r.status == 1);
+    CHECK(r.err == "sdfc: error: " + big + " reaches beyond 1e15 of the origin (-1.04e+20, -1.04e+20, -1.04e+20 to 1.04e+20, "
+                   "1.04e+20, 1.04e+20): scale it down to mesh it\n");
     auto raised = run_sdfc("mesh " + q(s) + " -o " + q(test::temp_dir() + "/raised.stl") + " --resolution 8 --max-cells 5e9 -q");
     CHECK(raised.status == 0);  // above the default limit and above what an int holds
     const std::string plane = test::write_temp("mesh_plane.sdf", "plane([0, 1, 0], 0);\n");
