@@ -131,7 +131,9 @@ bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float
         }
     }
     const glm::vec3 ext = bhi - blo;
-    const float longest = std::max({ext.x, ext.y, ext.z, 1e-3f});
+    // (a margin of its own size: a part of a micrometre keeps its cells; a point gets 1e-3)
+    float longest = std::max({ext.x, ext.y, ext.z});
+    if (!(longest > 0.0f)) longest = 1e-3f;
     float m = 0.02f * longest;
     // (a floor at the rest's bounds is cut into a base m thick: one cell or less of it could
     // fall between the samples, leaving no base)

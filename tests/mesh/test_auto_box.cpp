@@ -61,6 +61,10 @@ TEST_CASE("auto box: unbounded scenes have none", "[mesh]") {
     CHECK_FALSE(box_of("field (p) -> 1;").found);  // no surface anywhere
 }
 
+TEST_CASE("auto box: a part of a micrometre gets a margin of its own size", "[mesh]") {
+    check_holds(box_of("sphere(1e-6);"), glm::vec3(-1e-6f), glm::vec3(1e-6f), 1e-7f);
+}
+
 TEST_CASE("auto box: shapes apart intersected (nothing anywhere) get [-1, 1]^3, where the mesh is empty", "[mesh]") {
     const Box b = box_of("intersection { translate([-2, 0, 0]) sphere(1); translate([2, 0, 0]) sphere(1); }");
     check_holds(b, glm::vec3(-1.0f), glm::vec3(1.0f), 0.05f);  // (with the usual margin)
