@@ -34,7 +34,7 @@ constexpr uint32_t kGone = ~0u;
 constexpr size_t kRound = 1024;  // collapses asked of the field at once
 constexpr size_t kGrain = 32;   // of them per task
 constexpr size_t kMaxValence = 40;          // keeps fans, and the checks on them, small
-constexpr size_t kSlot = kMaxValence + 8;    // room for one collapse's probes, or its requeued edges
+constexpr size_t kSlot = 2 * kMaxValence + 8;  // room for one collapse's probes, or its requeued edges
 constexpr float kMinTurn = 0.2f;            // cosine: a triangle may turn by up to ~78 degrees
 constexpr float kSliver = 0.05f;
 constexpr int kPasses = 3;     // the queue made again from every edge at most this often
@@ -348,6 +348,15 @@ private:
                 const float cos_min = std::min({glm::dot(n[0], n[1]), glm::dot(n[1], n[2]), glm::dot(n[2], n[0])});
                 const float theta = std::acos(std::clamp(cos_min, -1.0f, 1.0f));
                 if (!(len * theta * 0.125f <= kSag * tol_)) out[count++] = (p[0] + p[1] + p[2]) / 3.0f;
+                // The middle of the new edge after the moved vertex (each new edge is that of
+                // one triangle): a surface curving along it sags most there.
+                for (int k = 0; k < 3; ++k) {
+                    if (t[size_t(k)] != x) continue;
+                    const int e = (k + 1) % 3;
+                    const float edge = glm::length(p[e] - p[k]);
+                    const float turn = std::acos(std::clamp(glm::dot(n[k], n[e]), -1.0f, 1.0f));
+                    if (!(edge * turn * 0.125f <= kSag * tol_)) out[count++] = 0.5f * (p[k] + p[e]);
+                }
             }
         return count;
     }
@@ -361,7 +370,7 @@ private:
     bool near_surface(const Dual& d) const {
         const float g = std::sqrt(d.dx * d.dx + d.dy * d.dy + d.dz * d.dz);
         const float dist = std::fabs(d.v) / (g > 1e-6f ? g : 1.0f);
-        return dist <= tol_;  // NaN: not
+        return dist <= 0.9f * tol_;  // (a tenth kept for what lies between the probes) NaN: not
     }
 
     // Returns the collapses of u's edges to queue, in out (kSlot at most).
