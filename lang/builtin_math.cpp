@@ -240,7 +240,9 @@ Value Interp::make_param(std::vector<Value>& args, const std::vector<Loc>& locs,
     const float lo = args.size() > 1 ? v[1] : value - span, hi = args.size() > 2 ? v[2] : value + span;
     if (!(lo < hi)) fail(args.size() > 2 ? locs[2] : loc, fmt::format("the param's max ({}) must be above its min ({})", hi, lo));
     if (value < lo || value > hi) fail(locs[0], fmt::format("the param's value {} is outside [{}, {}]", value, lo, hi));
-    const float step = args.size() > 3 ? v[3] : (hi - lo) / 1000.0f;
+    // By default the power of ten at most a thousandth of the range: whole numbers (and
+    // tenths...) lie on the slider's grid, as a count or a `-D` value needs.
+    const float step = args.size() > 3 ? v[3] : std::pow(10.0f, std::floor(std::log10((hi - lo) / 1000.0f)));
     if (!(step > 0.0f)) fail(locs[3], "the param's step must be above 0");
     if (opts.time || param_fixed) return Value::number(g->constant(value));  // the CPU (or -D's): a constant
     // Each is a uniform; WebGL2 promises 224 vectors for a fragment shader, the renderer's own included.

@@ -95,7 +95,7 @@
   var scene = { uses_time: false, samples: 1, max_steps: 256, max_bounces: 3, params: [] };
   var cur = null, tCompile = 0;
   var knobs = { samples: 0, steps: 0, bounces: -1 };  // 0 / -1: the script's
-  var paramValues = {}, controls = false;
+  var paramValues = Object.create(null), controls = false;  // (no inherited names: a param may be called constructor)
   function setScene(info) {
     scene = info;
     scene.params = scene.params || [];

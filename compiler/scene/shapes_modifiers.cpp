@@ -133,7 +133,8 @@ PolarCopies polar_neighbours(const Bounds& b, float n) {
 Lowered repeat(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited, bool finite) {
     static_assert(size_t(RepeatP::period) == size_t(RepeatFiniteP::period));
     Graph& g = l.g;
-    auto count = [&](int i) { return P(s, RepeatFiniteP::count + i); };
+    // (a count of 1.5 is 1 each side, as in GLSL, where a param count is floored: no copy at 1.5 periods)
+    auto count = [&](int i) { return g.unary(Op::Floor, P(s, RepeatFiniteP::count + i)); };
     Vec3N per = P3(s, RepeatP::period);
     const Bounds cb = shape_bounds(g, *s.children.at(0));
     std::array<NodeId, 3> idx{kNoNode, kNoNode, kNoNode};

@@ -59,6 +59,7 @@ TEST_CASE("params: GLSL reads them from sdf_param[]") {
     CHECK(s.params[0].value == 0.7f);
     CHECK(s.params[1].min == -0.5f);
     CHECK(s.params[1].step == 0.25f);
+    CHECK(s.params[0].step == 0.001f);  // (0.2 to 1.5 by default: a power of ten, so round values lie on the slider)
     CHECK(s.params[0].loc.line == 1);
     const std::string st = emit_glsl(s, GlslTarget::Shadertoy);
     CHECK(st.find("#define SDF_PARAM_size 0.7  // in [0.2, 1.5]; line 1") != std::string::npos);
@@ -66,6 +67,7 @@ TEST_CASE("params: GLSL reads them from sdf_param[]") {
     CHECK(st.find("sdf_param[int(0.0)]") != std::string::npos);
     const std::string page = emit_glsl(s, GlslTarget::Html);
     CHECK(page.find("uniform float sdf_param[2];") != std::string::npos);
+    CHECK(page.find("var paramValues = Object.create(null)") != std::string::npos);  // (a param named constructor)
     CHECK(page.find("{\"name\":\"lift\",\"value\":0,\"min\":-0.5,\"max\":1,\"step\":0.25,\"uniform\":\"sdf_param[1]\"}") !=
           std::string::npos);
 }

@@ -108,6 +108,7 @@ void add_operation_cases(std::vector<Case>& out) {
     s.script("repeat([3, 0, 3]) sphere(0.5);").at(0, 3, 0, 2.5);  // y is not repeated
     s.script("repeat(2, 1) sphere(0.5);").at(2, 2, -2, -0.5).at(4, 0, 0, 1.5);  // index 1 present, index 2 absent
     s.script("repeat([2, 0, 0], [2, 0, 0]) sphere(0.5);").at(-4, 0, 0, -0.5).at(6, 0, 0, 1.5).at(0, 2, 0, 1.5);
+    s.script("repeat([2, 0, 0], [1.5, 0, 0]) sphere(0.5);").at(2, 0, 0, -0.5).at(3, 0, 0, 0.5);  // a count is whole: 1.5 is 1
 
     // Cells are centred on the child: an off-centre child is whole, and a point by its cell's
     // face sees the copy next door (-0.99: the copy at -1.15, not its own at 0.85). The copies
