@@ -136,7 +136,7 @@ int cmd_merge(Args& a) {
         const Image& b = bands[k];
         const std::string& name = parts[k];
         if (b.picture != first.picture)
-            throw std::runtime_error(fmt::format("'{}' is a band of another picture than '{}' (another scene, frame, setting or AOV)", name,
+            throw std::runtime_error(fmt::format("'{}' is a band of another picture than '{}' (another scene, frame, setting, AOV or N of --tiles I/N)", name,
                                                  parts[order[0]]));
         if (b.width != img.width || b.full_height != img.height || b.channels != img.channels || b.aovs.size() != img.aovs.size())
             throw std::runtime_error(fmt::format("'{}' is a band of another picture ({}x{}, {} channels) than '{}' ({}x{}, {} channels)", name,

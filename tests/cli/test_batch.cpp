@@ -164,7 +164,7 @@ TEST_CASE("render --tiles bands and sdfc merge make the one-render picture, byte
     auto mixed = run_sdfc("merge " + q(dir + "/part0.exr") + " " + q(dir + "/other1.exr") + " " + q(dir + "/part2.exr") + " -o " + q(dir + "/x.png"));
     CHECK(mixed.status == 1);
     CHECK(mixed.err == "sdfc: error: '" + dir + "/other1.exr' is a band of another picture than '" + dir +
-                           "/part0.exr' (another scene, frame, setting or AOV)\n");
+                           "/part0.exr' (another scene, frame, setting, AOV or N of --tiles I/N)\n");
     auto self = run_sdfc("merge " + q(dir + "/part0.exr") + " -o " + q(dir + "/part0.exr"));
     CHECK(self.status == 1);
     CHECK(self.err == "sdfc: error: cannot write '" + dir + "/part0.exr': it is one of the bands merged ('" + dir + "/part0.exr')\n");
