@@ -122,6 +122,17 @@ PolarCopies polar_neighbours(const Bounds& b, float n) {
     return pc;
 }
 
+// Whether each copy of `s` is the nearest in its own centred cell (or sector), so the
+// copies left out need no floor: a sphere (its distance grows with the distance from its
+// centre) or, on a lattice, a box along the axes (with each axis' offset), moved by
+// translations. Most repeated children in scripts are these.
+bool own_copy_nearest(const Shape& s, bool lattice) {
+    const Shape* c = &s;
+    while ((c->kind == ShapeKind::Translate || c->kind == ShapeKind::Material) && c->children.size() == 1 && c->children[0])
+        c = c->children[0].get();
+    return c->kind == ShapeKind::Sphere || (lattice && c->kind == ShapeKind::Box);
+}
+
 // Domain repetition: the point moves into its cell, and the child is evaluated there. The
 // cells are centred on the child's box (an off-centre child, `repeat(v) translate(t) s`,
 // sits in the middle of its cell). A child that reaches out of its cell would be cut at the
@@ -161,7 +172,7 @@ Lowered repeat(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited,
         // that fill their cells, a lattice's struts, would floor the distance to 0 on every
         // face. Such a child is its cell's nearest copy when it is symmetric, as they are.)
         const float gap = std::min(lo[i] + float(jhi[i] + 1) * pe - half, -half - hi[i] - float(jlo[i] - 1) * pe);
-        boxed[i] = std::isfinite(gap) && gap >= 0.05f * pe;
+        boxed[i] = std::isfinite(gap) && gap >= 0.05f * pe && !own_copy_nearest(*s.children.at(0), true);
     }
     std::optional<Lowered> acc;  // the copies are one child: one Lipschitz bound
     for (int jx = jlo[0]; jx <= jhi[0]; ++jx)
@@ -304,7 +315,7 @@ Lowered lower_PolarRepeat(L& l, const Shape& s, const Vec3N& p, const MaterialN*
         Lowered c = child(l, s, {l.mul(g.unary(Op::Cos, aj), r), p[1], l.mul(g.unary(Op::Sin, aj), r)}, inherited);
         acc = acc ? nearer(l, *acc, c, inherited) : c;
     }
-    if (pc.floor) {
+    if (pc.floor && !own_copy_nearest(*s.children.at(0), false)) {
         const float step = 2 * kPi / g.const_value(n);
         // Round from a to the next copy left out either way, at most a quarter turn.
         const NodeId above = l.sub(l.c(pc.a0 + step * float(pc.js.size())), a), below = l.sub(a, l.c(pc.a1 - step * float(pc.js.size())));

@@ -118,6 +118,15 @@ void add_operation_cases(std::vector<Case>& out) {
     for (int k = -2; k <= 2; ++k) fc.push_back({0.9 + 2.0 * k, 0, 0});
     const auto far = [](const ShapeCases::Ref& ref) { return [ref](double x, double y, double z) { return ref(x, y, z) > 0.3; }; };
     s.script("repeat([2, 0, 0], 2) translate([0.9, 0, 0]) sphere(0.5);", 6).at(1.3f, 0, 0, -0.1f).random_bound(spheres(fc, 0.5), far(spheres(fc, 0.5)), 1e-4, 6, 300, 99, 1e-4);
+    // A child of two parts (no sphere alone: the floor is in its program), copies at 3k.
+    std::vector<std::array<double, 3>> big, small;
+    for (int k = -3; k <= 3; ++k) big.push_back({0.9 + 3.0 * k, 0, 0}), small.push_back({-0.3 + 3.0 * k, 0, 0});
+    const ShapeCases::Ref two = [big, small](double x, double y, double z) {
+        return std::min(spheres(big, 0.3)(x, y, z), spheres(small, 0.2)(x, y, z));
+    };
+    s.script("repeat([3, 0, 0]) union { translate([0.9, 0, 0]) sphere(0.3); translate([-0.3, 0, 0]) sphere(0.2); }", 4)
+        .at(-1.95f, 0, 0, -0.15f, 1e-4)  // inside the big sphere at -2.1
+        .random_bound(two, far(two), 1e-4, 4, 300, 7, 1e-4);
     s.script("repeat([2, 0, 0]) translate([0.85, 0, 0]) sphere(0.1);").at(-0.99f, 0, 0, 0.06f, 1e-4).at(0.85f, 0.5f, 0, 0.4f);
     s.script("repeat([2, 0, 0]) translate([0.45, 0, 0]) sphere(0.5);").at(-0.62f, 0, 0, 0.43f, 1e-4);
     // Infinite, on two axes, a child across a corner of its cell.
@@ -131,6 +140,17 @@ void add_operation_cases(std::vector<Case>& out) {
     s.script("polar_repeat(3) translate([0, 0, 2]) sphere(0.5);", 4).at(0, 0, 2, -0.5).random_bound(spheres(pc, 0.5), far(spheres(pc, 0.5)), 1e-4, 4, 300, 99, 1e-4);
     // Sectors centred on an off-centre child: the copy next door is seen past the sector's edge.
     s.script("polar_repeat(4) translate([1, 0, 0.5]) sphere(0.2);").at(0.764f, 0.05f, 0.791f, 0.17799f, 1e-4);
+    std::vector<std::array<double, 3>> pa, pb;
+    for (int k = 0; k < 4; ++k) {
+        const double a = k * M_PI / 2;  // copy k turned by k quarter turns: (x, z) -> (x cos - z sin, x sin + z cos)
+        pa.push_back({1.0 * std::cos(a) - 0.5 * std::sin(a), 0, 1.0 * std::sin(a) + 0.5 * std::cos(a)});
+        pb.push_back({1.5 * std::cos(a), 0, 1.5 * std::sin(a)});
+    }
+    const ShapeCases::Ref pair = [pa, pb](double x, double y, double z) {
+        return std::min(spheres(pa, 0.2)(x, y, z), spheres(pb, 0.1)(x, y, z));
+    };
+    s.script("polar_repeat(4) union { translate([1, 0, 0.5]) sphere(0.2); translate([1.5, 0, 0]) sphere(0.1); }", 3)
+        .random_bound(pair, far(pair), 1e-4, 3, 300, 7, 1e-4);
     s.script("polar_repeat(6) translate([2, 0, 0]) sphere(0.3);").at(2, 0, 0, -0.3);
 
     // symmetry mirrors the positive side onto the negative; x folds unless y or z is named.
