@@ -50,6 +50,11 @@ Common read_common(Args& a) {
             throw UsageError(fmt::format("-D takes NAME=VALUE (a top-level let of the script and an expression), not '{}'", d));
         for (const Define& seen : c.interp.defines)
             if (seen.name == name) throw UsageError(fmt::format("-D {} is given twice", name));
+        try {  // (a message would quote the bytes as they are)
+            check_source_text(SourceFile("-D", d.substr(eq + 1)));
+        } catch (const CompileError&) {
+            throw UsageError(fmt::format("-D {}: the value is not text (a NUL byte or invalid UTF-8)", name));
+        }
         c.interp.defines.push_back({name, d.substr(eq + 1)});
     }
     return c;
