@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <regex>
 #include <sstream>
 #include <thread>
@@ -129,17 +130,29 @@ const char* kRed = "background([0, 0, 0]);\ncolor([1, 0, 0]) sphere(1.5);\n";
 const char* kBlue = "background([0, 0, 0]);\ncolor([0, 0, 1]) sphere(1.5);\n";
 const char* kBroken = "background([0, 0, 0]);\ncolor([0, 0, 1]) sphere(1.5;\n";
 
+// A preview of kRed in a folder of its own, serving once its first build is done.
+struct Served {
+    std::string scene, log;
+    std::unique_ptr<Background> server;
+    int port = -1;
+    explicit Served(const std::string& name) {
+        const std::string dir = test::temp_dir() + "/" + name;
+        fs::create_directories(dir);
+        scene = dir + "/scene.sdf", log = dir + "/log.txt";
+        save(scene, kRed);
+        server = std::make_unique<Background>("'" + std::string(SDFC_BIN_PATH) + "' preview --port 0 --debounce 50 " + q(scene), log);
+        port = port_from(log);
+        REQUIRE(port > 0);
+        REQUIRE(eventually([&] { return test::slurp(log); }, [](const std::string& s) { return s.find("version 1 ok in ") != std::string::npos; }));
+    }
+};
+
 }  // namespace
 
 TEST_CASE("preview serves the live page and sends each save's shader or error") {
-    const std::string dir = test::temp_dir() + "/preview";
-    fs::create_directories(dir);
-    const std::string scene = dir + "/scene.sdf", log = dir + "/log.txt";
-    save(scene, kRed);
-    Background server("'" + std::string(SDFC_BIN_PATH) + "' preview --port 0 --debounce 50 " + q(scene), log);
-    const int port = port_from(log);
-    REQUIRE(port > 0);
-    REQUIRE(eventually([&] { return test::slurp(log); }, [](const std::string& s) { return s.find("version 1 ok in ") != std::string::npos; }));
+    const Served served("preview");
+    const std::string &scene = served.scene, &log = served.log;
+    const int port = served.port;
 
     httplib::Client cli("127.0.0.1", port);
     auto page = cli.Get("/");
@@ -172,14 +185,9 @@ TEST_CASE("preview serves the live page and sends each save's shader or error") 
 }
 
 TEST_CASE("many open pages: each has its stream, page loads still answer, past 48 streams a 503") {
-    const std::string dir = test::temp_dir() + "/preview-many";
-    fs::create_directories(dir);
-    const std::string scene = dir + "/scene.sdf", log = dir + "/log.txt";
-    save(scene, kRed);
-    Background server("'" + std::string(SDFC_BIN_PATH) + "' preview --port 0 " + q(scene), log);
-    const int port = port_from(log);
-    REQUIRE(port > 0);
-    REQUIRE(eventually([&] { return test::slurp(log); }, [](const std::string& s) { return s.find("version 1 ok in ") != std::string::npos; }));
+    const Served served("preview-many");
+    const std::string &scene = served.scene, &log = served.log;
+    const int port = served.port;
     std::vector<int> open;
     for (int i = 0; i < 48; ++i) {  // httplib's own pool had 8 threads: the 9th page waited for ever
         int fd = -1;
