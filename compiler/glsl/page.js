@@ -76,10 +76,15 @@
   // The tape of a long scene (compiler/glsl/glsl_tape.hpp): base64 words, uploaded as an
   // RGBA32UI texture of 1024 texels a row on unit 0, where the shader's sdf_tape reads it.
   var tapeTex = null;
+  // A tape taller than the GPU's textures is an error on the page, and the last one stays.
   function uploadTape(b64) {
+    var bin = b64 ? atob(b64) : '', width = 1024, texels = bin.length >> 4, rows = Math.max(1, Math.ceil(texels / width));
+    var most = gl.getParameter(gl.MAX_TEXTURE_SIZE);
+    if (b64 && rows > most)
+      throw new Error('the scene\'s tape (' + texels + ' texels) is over this GPU\'s texture size (' + width + ' x ' + most +
+                      '): simplify the scene, or use sdfc glsl --target shadertoy');
     if (tapeTex) { gl.deleteTexture(tapeTex); tapeTex = null; }
     if (!b64) return;
-    var bin = atob(b64), width = 1024, texels = bin.length >> 4, rows = Math.max(1, Math.ceil(texels / width));
     var bytes = new Uint8Array(rows * width * 16);
     for (var i = 0; i < bin.length; ++i) bytes[i] = bin.charCodeAt(i);
     tapeTex = gl.createTexture();
@@ -447,7 +452,12 @@
       var t0 = performance.now();
       try {
         var next = program(m.shader, m.scene.params || []);
-        uploadTape(m.tape || '');
+        try {
+          uploadTape(m.tape || '');
+        } catch (err) {
+          gl.deleteProgram(next.prog);
+          throw err;
+        }
         if (cur) gl.deleteProgram(cur.prog);
         cur = next;
         drawnVersion = m.version;

@@ -68,6 +68,7 @@ TEST_CASE("params: GLSL reads them from sdf_param[]") {
     const std::string page = emit_glsl(s, GlslTarget::Html);
     CHECK(page.find("uniform float sdf_param[2];") != std::string::npos);
     CHECK(page.find("var paramValues = Object.create(null)") != std::string::npos);  // (a param named constructor)
+    CHECK(page.find("is over this GPU\\'s texture size") != std::string::npos);  // (a tape taller than MAX_TEXTURE_SIZE)
     CHECK(page.find("{\"name\":\"lift\",\"value\":0,\"min\":-0.5,\"max\":1,\"step\":0.25,\"uniform\":\"sdf_param[1]\"}") !=
           std::string::npos);
 }
