@@ -1,6 +1,7 @@
 // IR Graph -> register Program: instruction selection (immediate forms, MulAddI and
 // Length2I/3I fusion), then linear-scan register allocation in SSA order (the policy of
 // regalloc.hpp).
+#include <cmath>
 #include <algorithm>
 #include <limits>
 
@@ -56,7 +57,9 @@ std::vector<Sel> select(const Graph& g, const std::vector<uint8_t>& live, const 
         if (op_info(nd.op).arity == 2 && !op_info(nd.op).has_imm) {
             bool ca = g.is_const(nd.a), cb = g.is_const(nd.b);
             Op f; bool inv;
-            if (cb && imm_form(nd.op, 1, f, inv)) {
+            // (x / 0 stays a division: its reciprocal would be an infinite immediate, and x / 0
+            // is x's sign of infinity per point, as in Fidget's models and GLSL.)
+            if (cb && imm_form(nd.op, 1, f, inv) && (!inv || std::isfinite(1.0f / g.const_value(nd.b)))) {
                 float k = g.const_value(nd.b);
                 s = Sel{f, nd.a, kNoNode, kNoNode, inv ? 1.0f / k : k, true};
             } else if (ca && imm_form(nd.op, 0, f, inv)) {

@@ -153,6 +153,14 @@ TEST_CASE("a .vm name defined twice is an error at the second definition") {
     CHECK(r.err.rfind(vm + ":2:1: error: '_0' is already defined (line 1): each name is defined once\n", 0) == 0);
 }
 
+TEST_CASE("a .vm model may divide by a zero constant: infinity of x's sign per point, as in Fidget") {
+    std::string vm = test::write_temp("div0.vm", "x var-x\nc const 0\ny div x c\n");
+    auto r = run_sdfc("eval " + q(vm) + " --at 1,0,0");
+    CHECK(r.status == 0);
+    CHECK(r.out == "inf\n");
+    CHECK(run_sdfc("eval " + q(vm) + " --at -1,0,0").out == "-inf\n");
+}
+
 TEST_CASE("a NaN in a diagnostic reads nan, whatever its sign bit") {
     std::string vm = test::write_temp("sqrt.vm", "_0 const -1\n_1 sqrt _0\n_2 var-x\n_3 add _1 _2\n");
     auto r = run_sdfc("check " + q(vm));
