@@ -92,7 +92,7 @@ struct base_control : pegtl::normal<Rule> {
             }
         } guard{nullptr};
         if constexpr (nests) {
-            // (A top-level statement is the first level: N parentheses in it are N more.)
+            // (A top-level statement is no level of its own: N parentheses in it pass a limit of N.)
             if (st.depth > st.max_depth)
                 throw CompileError(st.loc_at(in.current()), fmt::format("nesting deeper than {} levels ({})", st.max_depth,
                                                st.max_depth >= unsigned(ParseOptions::kMostNesting) ? "the most --max-nesting allows"
