@@ -123,11 +123,7 @@ int cmd_mesh(Args& a) {
         for (float v : f)  // (as the camera: beyond, a float cannot place a vertex within a cell)
             if (!(std::fabs(v) <= 1e15f)) throw UsageError("--bounds must lie within 1e15 of the origin on each axis");
     } else if (!mesh::default_box(cs, mo.lo, mo.hi, t, 8192, mo.resolution)) {
-        const auto& code = cs.distance.code;
-        const bool reads_point = std::any_of(code.begin(), code.end(), [](const Instr& in) {
-            return in.op == Op::VarX || in.op == Op::VarY || in.op == Op::VarZ;
-        });
-        if (!reads_point) throw std::runtime_error(fmt::format("{} has no surface (its distance is the same everywhere): nothing to mesh", path));
+        if (!reads_point(cs.distance)) throw std::runtime_error(fmt::format("{} has no surface (its distance is the same everywhere): nothing to mesh", path));
         throw UsageError("the scene is unbounded (a plane, an infinite repetition, shapes beyond 1e29?): give --bounds X0,Y0,Z0,X1,Y1,Z1");
     } else if (!(glm::all(glm::lessThanEqual(glm::abs(mo.lo), glm::vec3(1e15f))) && glm::all(glm::lessThanEqual(glm::abs(mo.hi), glm::vec3(1e15f))))) {
         // (as --bounds: beyond, a float cannot place a vertex within a cell, and squares overflow)

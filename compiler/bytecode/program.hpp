@@ -72,6 +72,13 @@ struct Program {
     }
 };
 
+// Whether the program reads the point (x, y or z): one that does not is the same everywhere.
+inline bool reads_point(const Program& p) {
+    for (const Instr& in : p.code)
+        if (in.op == Op::VarX || in.op == Op::VarY || in.op == Op::VarZ) return true;
+    return false;
+}
+
 // Linear-scan register allocation over the live nodes reachable from `roots`; constant
 // operands become immediates where an *_I form exists; Add(MulI(x), y) fuses to MulAddI.
 // The graph's guarded regions (Graph::guards) become guard instructions, each region's

@@ -303,8 +303,9 @@ Lowered lower_PolarRepeat(L& l, const Shape& s, const Vec3N& p, const MaterialN*
     Graph& g = l.g;
     NodeId n = P(s, PolarRepeatP::n);
     NodeId ang = l.div(l.c(2 * kPi), n);
+    const Bounds cb = shape_bounds(g, *s.children.at(0));
     PolarCopies pc;
-    if (g.is_const(n)) pc = polar_neighbours(shape_bounds(g, *s.children.at(0)), g.const_value(n));
+    if (g.is_const(n)) pc = polar_neighbours(cb, g.const_value(n));
     const NodeId centre = l.c(pc.centre);
     NodeId a = l.add(l.sub(g.binary(Op::Atan2, p[2], p[0]), centre), l.mul(ang, l.c(0.5f)));
     NodeId r = l.len2(p[0], p[2]);
@@ -320,7 +321,7 @@ Lowered lower_PolarRepeat(L& l, const Shape& s, const Vec3N& p, const MaterialN*
         // Round from a to the next copy left out either way, at most a quarter turn.
         const NodeId above = l.sub(l.c(pc.a0 + step * float(pc.js.size())), a), below = l.sub(a, l.c(pc.a1 - step * float(pc.js.size())));
         const NodeId d = l.clamp(l.mn(above, below), l.c(0.0f), l.c(0.5f * kPi));
-        const Bounds cb = shape_bounds(g, *s.children.at(0));  // (and no nearer than its height)
+        // (no nearer than its height either)
         const NodeId dy = cb.lo.y > -1e29f && cb.hi.y < 1e29f
                               ? l.mx(l.mx(l.sub(l.c(cb.lo.y), p[1]), l.sub(p[1], l.c(cb.hi.y))), l.c(0.0f))
                               : l.c(0.0f);

@@ -121,10 +121,7 @@ bool default_box(const CompiledScene& scene, glm::vec3& lo, glm::vec3& hi, float
         const Program& p = scene.solid.outputs.empty() ? scene.distance : scene.solid;
         bool nothing = false;
         if (!interval_box(p, true, time, blo, bhi, search_cells, &nothing)) {
-            const bool reads_point = std::any_of(p.code.begin(), p.code.end(), [](const Instr& in) {
-                return in.op == Op::VarX || in.op == Op::VarY || in.op == Op::VarZ;
-            });
-            if (!nothing || !reads_point) return false;  // (a constant field has no surface to find)
+            if (!nothing || !reads_point(p)) return false;  // (a constant field has no surface to find)
             // Proved empty everywhere (an intersection of shapes apart): a box where the
             // mesh is empty, as it is for a difference that removes all.
             blo = glm::vec3(-1.0f), bhi = glm::vec3(1.0f);
