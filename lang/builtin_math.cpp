@@ -261,6 +261,10 @@ Value Interp::lookup(std::vector<Value>& args, const std::vector<Loc>& locs, Loc
     NodeId key = num(args[0], locs[0], "lookup's key");
     std::vector<std::pair<float, float>> rows;
     auto row = [&](const Value& r) {
+        if (r.t == VT::List && r.list->size() == 2)  // [key, vector]: a pair, but not of numbers
+            for (const Value& x : *r.list)
+                if (x.t != VT::Number)
+                    fail(locs[1], fmt::format("lookup's table holds [key, value] pairs of numbers; this pair holds {}", describe(x)));
         if (r.t != VT::Vector || r.n != 2 || !gr.is_const(r.c[0]) || !gr.is_const(r.c[1]))
             fail(locs[1], fmt::format("lookup's table holds [key, value] pairs of constants, not {}", describe(r)));
         rows.emplace_back(gr.const_value(r.c[0]), gr.const_value(r.c[1]));

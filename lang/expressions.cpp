@@ -72,6 +72,14 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                     if (j > i) failed_lets.insert(std::string(ln.substr(i, j - i)));
                 }
             }
+            // OpenSCAD hoists a file's assignments; here a let takes effect from its line on.
+            for (const auto& mod : modules)
+                if (mod->file == e.loc.file)
+                    for (const auto& st : mod->stmts)
+                        if (st->kind == ast::StmtKind::Let && st->name == e.text && st->name_loc.line > e.loc.line)
+                            fail(e.loc, fmt::format("unknown name '{}' here: it is defined below, at line {} (a let takes effect "
+                                                    "from its line on; move it above its first use)",
+                                                    e.text, st->name_loc.line));
             fail(e.loc, unknown_name_message(e.text, names));
         }
         case K::Vector: {
@@ -205,6 +213,23 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
         case K::Index: {
             Value v = eval(*e.lhs, env);
             Value ix = eval(*e.rhs, env);
+            if (v.t == VT::List && !v.list->empty()) {
+                // An index that varies (the point, time, a param) picks from numbers or vectors of
+                // one size, rounded and clamped as a vector's: a chain of selects.
+                const NodeId in = ix.t == VT::Number ? ix.c[0] : kNoNode;
+                const Value& first = v.list->front();
+                const bool same = std::all_of(v.list->begin(), v.list->end(), [&](const Value& x) {
+                    return (x.t == VT::Number || x.t == VT::Vector) && x.t == first.t && x.n == first.n;
+                });
+                if (in != kNoNode && !g->is_const(in) && same) {
+                    Value r = v.list->back();
+                    for (size_t i = v.list->size() - 1; i-- > 0;) {
+                        const NodeId below = g->binary(Op::Lt, in, g->constant(float(i) + 0.5f));
+                        for (int k = 0; k < r.n; ++k) r.c[k] = g->select(below, (*v.list)[i].c[k], r.c[k]);
+                    }
+                    return r;
+                }
+            }
             if (v.t == VT::List) {
                 float i = const_num(ix, e.rhs->loc, "an index");
                 if (i != std::floor(i)) fail(e.rhs->loc, fmt::format("index {} is not a whole number", i));

@@ -117,6 +117,7 @@ public:
     void exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out);
     void exec_rest(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out);
     [[noreturn]] void bad_statement(const ast::Stmt& s, const Value& v);  // neither a shape nor a setting
+    void check_shape_before_shape(const ast::Expr& e);  // a def's `torus(1, 0.1) sphere(1)`: a ';' missing
     void exec_stmts(const std::vector<ast::StmtPtr>& stmts, Env* env, std::vector<ShapePtr>& out);
     Value call_value(const Value& callee, const std::vector<ast::Arg>& args, Env* env, Loc loc);
     // `last`: the value of the last parameter when no argument gives it (a user modifier's target).

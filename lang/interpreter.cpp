@@ -190,6 +190,18 @@ Scene Interp::run(const SourceFile& file) {
     if (!errors.empty()) throw CompileError(std::move(errors));
     check_defines_used(top);
     warn_unknown_names(modules, scene.warnings);
+    // Nothing drawn while a top-level let holds a shape: likely `let m = material(...)` with
+    // its ';' missing, which took the next line's shape as its target.
+    if (shapes.empty())
+        for (const auto& st : m.stmts)
+            if (st->kind == ast::StmtKind::Let) {
+                auto it = top->vars.find(st->name);
+                if (it != top->vars.end() && it->second.value.t == VT::Shape) {
+                    warn(st->name_loc, fmt::format("the scene has no shapes, but '{}' holds one: write `{};` to add it (or is the "
+                                                   "';' at the end of this let missing?)", st->name, st->name));
+                    break;
+                }
+            }
     scene.root = union_of(std::move(shapes), Loc{&file, 1, 1});
     return scene;
 }
@@ -266,6 +278,31 @@ struct IterItem {
     Value v;
 };
 
+// Whether the statement may add shapes (a shape call, a block, if or for holding one; not
+// a setting, an assignment or a definition): such an `if` or `for` is one CSG operand even
+// when it adds nothing (a false condition, no iterations), as in OpenSCAD, so that
+// `difference { for (i = [1 : n]) ...; sphere(1); }` with n = 0 is empty, not the sphere.
+bool may_add_shapes(const ast::Stmt& s) {
+    switch (s.kind) {
+        case ast::StmtKind::Expr: {
+            const ast::Expr& e = *s.value;
+            if (e.kind == ast::ExprKind::BlockExpr)
+                return e.block->result || std::any_of(e.block->stmts.begin(), e.block->stmts.end(), [](const ast::StmtPtr& x) { return may_add_shapes(*x); });
+            if (e.kind == ast::ExprKind::Call && e.callee && e.callee->kind == ast::ExprKind::Ident) {
+                const BuiltinInfo* b = find_builtin(e.callee->text);
+                return !b || b->kind != BuiltinKind::Setting;
+            }
+            return true;
+        }
+        case ast::StmtKind::If:
+            return (s.then_branch && may_add_shapes(*s.then_branch)) || (s.else_branch && may_add_shapes(*s.else_branch));
+        case ast::StmtKind::For:
+            return s.body && may_add_shapes(*s.body);
+        default:
+            return false;
+    }
+}
+
 // Where an earlier definition is, for a message about a later one at `here`: its line, and
 // its file when that is another (an imported name).
 std::string where_defined(const Loc& earlier, const Loc& here) {
@@ -293,6 +330,20 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
     if (v.t == VT::Modifier)
         fail(s.value->loc, fmt::format("'{}' needs a shape to apply to, e.g. {}(...) sphere(1);", v.mod->name, v.mod->name));
     fail(s.value->loc, fmt::format("this statement computes {} but does nothing with it (a statement must be a shape or a setting)", describe(v)));
+}
+
+// A def is only evaluated when called: its body's chain of modifiers is checked here, so
+// that `def ring(r) = torus(r, 0.1)` with its ';' missing (the next line's shape became a
+// target) is an error even if ring is never called.
+void Interp::check_shape_before_shape(const ast::Expr& e) {
+    for (const ast::Expr* x = &e; x && x->kind == ast::ExprKind::Apply; x = x->rhs.get()) {
+        const ast::Expr* lhs = x->lhs.get();
+        const ast::Expr* name = lhs && lhs->kind == ast::ExprKind::Call ? lhs->callee.get() : lhs;
+        if (!name || name->kind != ast::ExprKind::Ident) continue;
+        const BuiltinInfo* b = find_builtin(name->text);
+        if (b && b->kind == BuiltinKind::Shape && !redefinable_builtin(name->text))
+            fail(lhs->loc, "a shape is written before a shape but is not an operation (is a ';' missing after it?)");
+    }
 }
 
 [[gnu::noinline]] void Interp::exec_rest(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
@@ -351,6 +402,7 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             return;
         }
         case ast::StmtKind::Def: {
+            check_shape_before_shape(*s.value);
             if (find_builtin(s.name) && !redefinable_builtin(s.name))
                 fail(s.name_loc, fmt::format("'{}' is a built-in name and cannot be redefined", s.name));
             auto it = env->vars.find(s.name);
@@ -442,10 +494,12 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             std::optional<bool> k = const_truth(c, s.value->loc);
             if (k) {
                 const ast::Stmt* branch = *k ? s.then_branch.get() : s.else_branch.get();
+                const size_t before = out.size();
                 if (branch) {
                     Env* inner = new_env(env);
                     exec(*branch, inner, out);
                 }
+                if (out.size() == before && may_add_shapes(s)) out.push_back(union_of({}, s.loc));
                 return;
             }
             // A condition on the point or time: run both branches and merge the variables
@@ -490,10 +544,11 @@ void Interp::exec(const ast::Stmt& s, Env* env, std::vector<ShapePtr>& out) {
             // operand of a difference or an intersection (as in OpenSCAD).
             std::vector<ShapePtr> iters;
             run_for(s.bindings, env, s.loc, [&](Env* body) { exec(*s.body, body, iters); });
-            if (iters.size() <= 1) {
-                out.insert(out.end(), iters.begin(), iters.end());
+            if (iters.size() == 1) {
+                out.push_back(iters[0]);
                 return;
             }
+            if (iters.empty() && !may_add_shapes(s)) return;
             Shape u{ShapeKind::Union, s.loc};
             u.children = std::move(iters);
             u.iterations = true;

@@ -286,6 +286,14 @@ CompileError syntax_error(const SourceFile& f, size_t off, std::string msg) {
         const std::string_view first = word_at(t, start);
         const size_t e = start + first.size();
         std::string hint = e < t.size() && t[e] == ' ' ? habit_hint(first) : "";
+        if (hint.empty()) {
+            // ... or a statement inside a block on that line: `field (p) -> { float d = ...; d }`
+            size_t s = off;
+            while (s > start && t[s - 1] != ';' && t[s - 1] != '{') --s;
+            while (s < off && (t[s] == ' ' || t[s] == '\t')) ++s;
+            const std::string_view w = s > start ? word_at(t, s) : std::string_view();
+            if (!w.empty() && s + w.size() < t.size() && t[s + w.size()] == ' ') hint = habit_hint(w);
+        }
         if (hint.empty()) hint = openscad_hint(t, off);
         return CompileError(loc_at(f, previous_token_end(t, off)), std::string(msg) + hint);
     }

@@ -41,8 +41,14 @@ struct ModifierVal {
 
 struct RangeVal {
     float start = 0, step = 1, end = 0;
-    // The elements [start : step : end] holds (what `for` iterates).
-    double count() const { return std::max(0.0, std::floor((double(end) - start) / step + 1e-6) + 1); }
+    // The elements [start : step : end] holds (what `for` iterates). The ends and the step
+    // are floats: the slack covers their rounding (a few float ulps of each), so that
+    // [0 : 0.1 : 10] ends at 10 although 0.1f is a little over a tenth.
+    double count() const {
+        const double q = (double(end) - start) / step;
+        const double slack = 4.0 * 0x1p-24 * ((std::fabs(double(start)) + std::fabs(double(end))) / std::fabs(double(step)) + std::fabs(q)) + 1e-9;
+        return std::max(0.0, std::floor(q + slack) + 1);
+    }
 };
 
 struct Value {

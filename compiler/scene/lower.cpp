@@ -82,7 +82,14 @@ Bounds shape_bounds(const Graph& g, const Shape& s) {
     // Every parameter must be a constant for a finite answer.
     BoundsIn in{g, s, {}};
     for (NodeId n : s.params) {
-        if (!g.is_const(n)) return infinite();
+        if (!g.is_const(n)) {
+            // A rotation about the origin by an angle that varies (time, a param) keeps the
+            // child within its radius of the origin.
+            if (s.kind != ShapeKind::Rotate) return infinite();
+            const Bounds c = shape_bounds(g, *s.children.at(0));
+            if (is_empty(c) || !c.finite()) return c;
+            return sym(glm::vec3(glm::length(glm::max(glm::abs(c.lo), glm::abs(c.hi)))));
+        }
         in.v.push_back(g.const_value(n));
     }
     switch (s.kind) {

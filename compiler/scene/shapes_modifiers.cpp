@@ -147,16 +147,35 @@ Lowered repeat(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited,
     // (a count of 1.5 is 1 each side, as in GLSL, where a param count is floored: no copy at 1.5 periods)
     auto count = [&](int i) { return g.unary(Op::Floor, P(s, RepeatFiniteP::count + i)); };
     Vec3N per = P3(s, RepeatP::period);
-    const Bounds cb = shape_bounds(g, *s.children.at(0));
+    Bounds cb = shape_bounds(g, *s.children.at(0));
+    // A child that a translate moves by a varying offset (time, a param: GLSL's uniforms)
+    // has no constant box, but its box moves with it: the cells are centred on it as it
+    // moves (without this GLSL cut the copies at the faces of cells laid out for time 0).
+    Vec3N moved{kNoNode, kNoNode, kNoNode};
+    if (!cb.finite()) {
+        const Shape* c = s.children.at(0).get();
+        Vec3N off{l.c(0.0f), l.c(0.0f), l.c(0.0f)};
+        bool varies = false;
+        for (; (c->kind == ShapeKind::Translate || c->kind == ShapeKind::Material) && c->children.size() == 1 && c->children[0];
+             c = c->children[0].get())
+            if (c->kind == ShapeKind::Translate) {
+                const Vec3N v = P3(*c, TranslateP::v);
+                for (int i = 0; i < 3; ++i) varies |= !g.is_const(v[i]), off[i] = l.add(off[i], v[i]);
+            }
+        const Bounds inner = varies ? shape_bounds(g, *c) : cb;
+        if (varies && inner.finite()) cb = inner, moved = off;
+    }
     std::array<NodeId, 3> idx{kNoNode, kNoNode, kNoNode};
     std::array<int, 3> jlo{0, 0, 0}, jhi{0, 0, 0};
     std::array<bool, 3> boxed{false, false, false};  // the floor for the copies left out applies
     glm::vec3 mid(0.0f), lo(0.0f), hi(0.0f);          // the child's box about the cells' centres
+    Vec3N centre{kNoNode, kNoNode, kNoNode};          // the cells' centre: mid, moved with the child
     for (int i = 0; i < 3; ++i) {
         if (g.is_const(per[i]) && g.const_value(per[i]) == 0.0f) continue;  // axis left alone
         const bool fits = g.is_const(per[i]) && cb.lo[i] > -1e29f && cb.hi[i] < 1e29f && g.const_value(per[i]) > 0.0f;
         if (fits) mid[i] = 0.5f * cb.lo[i] + 0.5f * cb.hi[i], lo[i] = cb.lo[i] - mid[i], hi[i] = cb.hi[i] - mid[i];
-        const NodeId at = mid[i] == 0.0f ? p[i] : l.sub(p[i], l.c(mid[i]));
+        centre[i] = moved[i] != kNoNode && fits ? l.add(moved[i], l.c(mid[i])) : l.c(mid[i]);
+        const NodeId at = g.is_const(centre[i]) && g.const_value(centre[i]) == 0.0f ? p[i] : l.sub(p[i], centre[i]);
         idx[i] = g.unary(Op::Floor, l.add(l.div(at, per[i]), l.c(0.5f)));
         if (finite) idx[i] = l.clamp(idx[i], l.neg(count(i)), count(i));
         if (!fits) continue;
@@ -199,9 +218,9 @@ Lowered repeat(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited,
     std::array<NodeId, 3> u{kNoNode, kNoNode, kNoNode}, gap{kNoNode, kNoNode, kNoNode};
     for (int i = 0; i < 3; ++i) {
         const bool own = boxed[i] && jlo[i] == 0 && jhi[i] == 0;
-        if (boxed[i]) u[i] = l.sub(l.sub(p[i], l.c(mid[i])), l.mul(per[i], idx[i]));  // in [-half, half] but past a finite end
+        if (boxed[i]) u[i] = l.sub(l.sub(p[i], centre[i]), l.mul(per[i], idx[i]));  // in [-half, half] but past a finite end
         if (own) gap[i] = l.mx(l.mx(l.sub(l.c(lo[i]), u[i]), l.sub(u[i], l.c(hi[i]))), l.c(0.0f));
-        else if (idx[i] == kNoNode && cb.lo[i] > -1e29f && cb.hi[i] < 1e29f)
+        else if (idx[i] == kNoNode && moved[i] == kNoNode && cb.lo[i] > -1e29f && cb.hi[i] < 1e29f)
             gap[i] = l.mx(l.mx(l.sub(l.c(cb.lo[i]), p[i]), l.sub(p[i], l.c(cb.hi[i]))), l.c(0.0f));
     }
     NodeId floor = kNoNode;

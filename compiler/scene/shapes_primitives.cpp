@@ -184,7 +184,8 @@ Lowered lower_Cone(L& l, const Shape& s, const Vec3N& p) {
     NodeId k1x = r2, k1y = h, k2x = l.sub(r2, r1), k2y = l.mul(l.c(2), h);
     NodeId cax = l.sub(qx, l.mn(qx, l.sel(l.lt(qy, zero), r1, r2)));
     NodeId cay = l.sub(l.abs(qy), h);
-    NodeId k2k2 = l.add(l.sq(k2x), l.sq(k2y));
+    // (floored: a flat cylinder, h = 0 and r1 = r2, has k2 = 0 and would divide 0 by 0)
+    NodeId k2k2 = l.mx(l.add(l.sq(k2x), l.sq(k2y)), l.c(1e-30f));
     NodeId t = l.clamp(l.div(l.add(l.mul(l.sub(k1x, qx), k2x), l.mul(l.sub(k1y, qy), k2y)), k2k2), zero, l.c(1));
     NodeId cbx = l.add(l.sub(qx, k1x), l.mul(k2x, t));
     NodeId cby = l.add(l.sub(qy, k1y), l.mul(k2y, t));

@@ -166,3 +166,21 @@ TEST_CASE("glsl330 --tape-file writes the tape for a texture, and refuses what c
     for (const auto& e : std::filesystem::directory_iterator(test::temp_dir()))
         CHECK(e.path().filename().string().rfind(".many_tex2", 0) == std::string::npos);
 }
+
+TEST_CASE("a missing ';' after a def's shape is an error, after a let's material a warning, a let below its use named") {
+    const std::string d = test::write_temp("warn_semi_def.sdf", "def ring(r) = torus(r, 0.1)\nsphere(1);\n");
+    auto r = run_sdfc("check " + q(d));
+    CHECK(r.status == 1);
+    CHECK(r.err == d + ":1:15: error: a shape is written before a shape but is not an operation (is a ';' missing after it?)\n"
+                       "def ring(r) = torus(r, 0.1)\n              ^\n");
+    const std::string m = test::write_temp("warn_semi_let.sdf", "let m = material(color = [1, 0, 0])\nsphere(1);\n");
+    r = run_sdfc("check " + q(m));
+    CHECK(r.status == 0);
+    CHECK(r.err == m + ":1:5: warning: the scene has no shapes, but 'm' holds one: write `m;` to add it (or is the ';' at the end "
+                       "of this let missing?)\nlet m = material(color = [1, 0, 0])\n    ^\n");
+    const std::string u = test::write_temp("warn_let_below.sdf", "sphere(r);\nlet r = 1;\n");
+    r = run_sdfc("check " + q(u));
+    CHECK(r.status == 1);
+    CHECK(r.err == u + ":1:8: error: unknown name 'r' here: it is defined below, at line 2 (a let takes effect from its line on; "
+                       "move it above its first use)\nsphere(r);\n       ^\n");
+}

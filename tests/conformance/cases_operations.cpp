@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "conformance/cases.hpp"
+#include "support.hpp"
 
 namespace sdfc::conformance {
 
@@ -152,6 +153,21 @@ void add_operation_cases(std::vector<Case>& out) {
     s.script("polar_repeat(4) union { translate([1, 0, 0.5]) sphere(0.2); translate([1.5, 0, 0]) sphere(0.1); }", 3)
         .random_bound(pair, far(pair), 1e-4, 3, 300, 7, 1e-4);
     s.script("polar_repeat(6) translate([2, 0, 0]) sphere(0.3);").at(2, 0, 0, -0.3);
+    // A child that a param moves (in GLSL a uniform; here at its default): the cells move with
+    // it, so its copies are whole (they were cut at the faces of cells laid out for 0).
+    std::vector<std::array<double, 3>> mc;
+    for (int k = -3; k <= 3; ++k) mc.push_back({0.6 + 1.5 * k, 0, 0});
+    s.script("let off = param(0.6, 0, 1);\nrepeat([1.5, 0, 0]) translate([off, 0, 0]) sphere(0.35);", 4)
+        .at(0.85f, 0, 0, -0.1f, 1e-4)
+        .random_bound(spheres(mc, 0.35), far(spheres(mc, 0.35)), 1e-4, 4, 300, 5, 1e-4);
+    // A param's rotation keeps the child within its radius: the neighbouring sectors' copies
+    // are evaluated (the copy at -30 degrees reaches past its sector's edge at -36), and it
+    // gives what the same turn written as a constant gives.
+    std::shared_ptr<const test::Compiled> turned(test::compile_text("polar_repeat(5) rotate(y = 30) translate([1, 0, 0]) sphere(0.3);"));
+    s.script("let turn = param(30, 0, 90);\npolar_repeat(5) rotate(y = turn) translate([1, 0, 0]) sphere(0.3);", 2)
+        .at(float(std::cos(-40 * M_PI / 180)), 0, float(std::sin(-40 * M_PI / 180)), 2 * std::sin(5 * M_PI / 180) - 0.3, 1e-4)
+        .random([turned](double x, double y, double z) { return double(test::dist(turned->cs, float(x), float(y), float(z))); }, 2, 300,
+                1e-4, 5);
 
     // symmetry mirrors the positive side onto the negative; x folds unless y or z is named.
     s.script("symmetry(x = true) translate([2, 0, 0]) sphere(0.5);").at(-2, 0, 0, -0.5).at(2, 0, 0, -0.5);

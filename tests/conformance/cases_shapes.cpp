@@ -106,6 +106,7 @@ void add_primitive_cases(std::vector<Case>& out) {
     s.script("cone(2, 1);").at(0, -2, 0, 1);          // below the base centre
     s.script("cone(2, 1, 0.5);").at(0, 2, 0, 1);      // above the top disc
     s.script("cone(2, 1, 1);").at(2, 0, 0, 1);        // r1 = r2: a cylinder
+    s.script("cone(0, 1, 1);").at(0, 0.5, 0, 0.5).at(2, 0, 0, 1).at(0.5, -0.25, 0, 0.25);  // a flat disc (was 0/0)
     s.script("cone(2, 1, 0.25);").random(ref3([](dv3 p) {
         // Exact distance to a truncated cone by projecting onto its 2D profile polygon.
         double qx = len2(p.x, p.z), qy = p.y, h = 1, r1 = 1, r2 = 0.25;

@@ -45,6 +45,41 @@ TEST_CASE("for unions its iterations, nested bindings, vectors") {
     CHECK(close(dist_of("for (p = [[1, 0, 0], [0, 5, 0]]) translate(p) sphere(0.5);", 0, 5, 0), -0.5));
 }
 
+TEST_CASE("a range with a fractional step keeps its end, however many steps") {
+    // 0.1f is a little over a tenth: [0 : 0.1 : 10] used to stop at 9.9 (100 elements).
+    CHECK(close(dist_of("sphere(len([0 : 0.1 : 10]));", 0, 0, 0), -101));
+    CHECK(close(dist_of("sphere(len([10 : -0.1 : 0]));", 0, 0, 0), -101));
+    CHECK(close(dist_of("sphere(len([0 : 0.001 : 1]) / 100);", 0, 0, 0), -10.01));
+    CHECK(close(dist_of("sphere(len([0.1 : 0.1 : 1]));", 0, 0, 0), -10));
+    CHECK(close(dist_of("sphere(len([0 : 1 : 99.5]));", 0, 0, 0), -100));  // (not 101: 100 is past the end)
+    CHECK(close(dist_of("for (x = [0 : 0.1 : 10]) translate([x, 0, 0]) sphere(0.02);", 10, 0, 0), -0.02));
+}
+
+TEST_CASE("an if or a for that adds nothing is still one operand of a difference or intersection") {
+    // As in OpenSCAD: the statement is the first operand, empty; the sphere is not promoted.
+    CHECK(dist_of("let n = 0;\ndifference { for (i = [1 : n]) translate([i, 0, 0]) box(1); sphere(1); }", 0, 0, 0) > 1e19f);
+    CHECK(dist_of("difference { if (false) box(1); sphere(1); }", 0, 0, 0) > 1e19f);
+    CHECK(dist_of("intersection { if (false) box(1); sphere(1); sphere(2); }", 0, 0, 0) > 1e19f);
+    CHECK(dist_of("def holes(n) = { for (i = [1 : n]) box(1); };\ndifference { holes(0); sphere(1); }", 0, 0, 0) > 1e19f);
+    CHECK(dist_of("intersection { for (i = [1 : 0]) box(1); }", 0, 0, 0) > 1e19f);
+    // A setting under an if adds no operand; in a union an empty operand changes nothing.
+    CHECK(close(dist_of("difference { if (false) camera(position = [0, 0, 5]); sphere(1); box(0.5); }", 0, 0, 0), 0.25));
+    CHECK(close(dist_of("union { for (i = [1 : 0]) sphere(1); translate([5, 0, 0]) sphere(1); }", 0, 0, 0), 4));
+    CHECK(close(dist_of("difference { if (true) sphere(1); translate([1, 0, 0]) sphere(0.5); }", -0.5, 0, 0), -0.5));
+}
+
+TEST_CASE("an index that varies picks from a list of numbers or of vectors, rounded and clamped") {
+    const char* f = "field (p) -> length(p) - [0.5, 1, 1.5, 1, 0.5][p.x];";
+    CHECK(close(dist_of(f, 0.6f, 0, 0), -0.4));  // index 1
+    CHECK(close(dist_of(f, 2.4f, 0, 0), 0.9));   // index 2
+    CHECK(close(dist_of(f, -3, 0, 0), 2.5));     // clamped to the first
+    CHECK(close(dist_of(f, 9, 0, 0), 8.5));      // ... and the last
+    CHECK(close(dist_of("let c = [[0, 0, 0], [0, 1, 0], [0, 2, 0], [0, 3, 0], [0, 4, 0]];\n"
+                        "field (p) -> length(p - c[p.y]) - 0.5;", 0.2f, 3, 0), -0.3));
+    CHECK(test::first_error_line("let l = [1, [2, 3], 4, 5, 6];\nfield (p) -> length(p) - l[p.x];") ==
+          "test.sdf:2:28: error: an index must be known when the script runs (it depends on the point, on time or on a param)");
+}
+
 TEST_CASE("len counts a list's, a vector's, a range's elements and a string's characters") {
     CHECK(close(dist_of("let pts = [[0, 0], [1, 0], [0.5, 1], [0, 2]]; sphere(len(pts));", 0, 0, 0), -4));
     CHECK(close(dist_of("sphere(len([1, 2, 3]));", 0, 0, 0), -3));
@@ -69,6 +104,8 @@ TEST_CASE("concat, lookup and norm, as OpenSCAD's") {
     CHECK(close(dist_of("sphere(norm([0, 3, 4]));", 0, 0, 0), -5));
     CHECK(test::first_error_line("sphere(lookup(1, 2));") == "test.sdf:1:18: error: lookup's table is a list of [key, value] pairs, not a number");
     CHECK(test::first_error_line("sphere(lookup(1, []));") == "test.sdf:1:18: error: lookup's table is empty");
+    CHECK(test::first_error_line("sphere(lookup(0.5, [[0, [0, 0]], [1, [1, 1]]]));") ==
+          "test.sdf:1:20: error: lookup's table holds [key, value] pairs of numbers; this pair holds a 2-component vector");
 }
 
 TEST_CASE("a script's own len, norm, concat, lookup or param (names the contract does not reserve) wins") {
