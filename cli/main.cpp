@@ -250,6 +250,8 @@ int cmd_slice(Args& a) {
         auto f = Args::to_floats("--range", *range, 4);
         so.range = {f[0], f[1], f[2], f[3]};
         if (!(f[1] > f[0]) || !(f[3] > f[2])) throw UsageError("--range needs UMIN < UMAX and VMIN < VMAX");
+        for (float v : f)
+            if (!(std::fabs(v) <= 1e15f)) throw UsageError("--range must lie within 1e15 of the origin");
     }
     if (w) so.width = Args::to_int("--width", *w, 1, 16384);
     if (h) so.height = Args::to_int("--height", *h, 1, 16384);

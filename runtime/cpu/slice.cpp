@@ -1,5 +1,6 @@
 #include "runtime/cpu/slice.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -59,7 +60,9 @@ Image render_slice(const CompiledScene& scene, const SliceOptions& opt) {
         }
     }
     int w = opt.width;
-    int h = opt.height > 0 ? opt.height : std::max(1, int(std::lround(w * (r[3] - r[2]) / (r[1] - r[0]))));
+    // (in doubles, clamped before the conversion: a range of 1e-30 by 2 is 16384 rows, not int overflow)
+    const double rows = double(w) * (double(r[3]) - double(r[2])) / (double(r[1]) - double(r[0]));
+    int h = opt.height > 0 ? opt.height : int(std::lround(std::clamp(std::isfinite(rows) ? rows : 1.0, 1.0, 16384.0)));
     h = std::min(h, 16384);
     Image img(w, h, 3);
     float pix = (r[1] - r[0]) / float(w);

@@ -145,3 +145,27 @@ TEST_CASE("a render killed with SIGKILL never leaves a partial output") {
     ::waitpid(pid, &st, 0);
     if (WIFSIGNALED(st)) CHECK(!fs::exists(out));
 }
+
+TEST_CASE("a main picture that fails to write takes its new side files away, merge refuses a device, slice clamps its rows") {
+    const std::string dir = test::temp_dir() + "/sides";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string s = test::write_temp("sides.sdf", "sphere(1);\n");
+    // jp2 does not read back at 8 x 8: the depth side file, written first, must go too.
+    auto r = run_sdfc("render '" + s + "' -o '" + dir + "/x.jp2' --aov depth --width 8 --height 8 --quiet");
+    CHECK(r.status == 1);
+    CHECK(r.err.rfind("sdfc: error: cannot write '" + dir + "/x.jp2': ", 0) == 0);
+    CHECK(!fs::exists(dir + "/x.depth.png"));
+    CHECK(!fs::exists(dir + "/x.jp2"));
+    // A band from /dev/zero never ends: refused before it is read.
+    REQUIRE(run_sdfc("render '" + s + "' -o '" + dir + "/p1.exr' --tiles 1/2 --width 64 --height 64 --quiet").status == 0);
+    r = run_sdfc("merge /dev/zero '" + dir + "/p1.exr' -o '" + dir + "/m.png'");
+    CHECK(r.status == 1);
+    CHECK(r.err == "sdfc: error: cannot read '/dev/zero': not a regular file\n");
+    // A range 1e-30 wide and 2 tall is the tallest picture, not an int overflow's one row.
+    REQUIRE(run_sdfc("slice '" + s + "' --axis x --at 0 -o '" + dir + "/s.exr' --width 4 --range=-1e-30,1e-30,-1,1").status == 0);
+    CHECK(read_image(dir + "/s.exr").height == 16384);
+    r = run_sdfc("slice '" + s + "' --axis x --at 0 -o '" + dir + "/s.exr' --range=-3e38,3e38,-3e38,3e38");
+    CHECK(r.status == 2);
+    CHECK(r.err == "sdfc: error: --range must lie within 1e15 of the origin\n");
+}

@@ -167,7 +167,7 @@ TEST_CASE("glsl330 --tape-file writes the tape for a texture, and refuses what c
         CHECK(e.path().filename().string().rfind(".many_tex2", 0) == std::string::npos);
 }
 
-TEST_CASE("a missing ';' after a def's shape is an error, after a let's material a warning, a let below its use named") {
+TEST_CASE("a missing semicolon after a def's shape is an error, after a let's material a warning, a let below its use named") {
     const std::string d = test::write_temp("warn_semi_def.sdf", "def ring(r) = torus(r, 0.1)\nsphere(1);\n");
     auto r = run_sdfc("check " + q(d));
     CHECK(r.status == 1);
@@ -183,4 +183,15 @@ TEST_CASE("a missing ';' after a def's shape is an error, after a let's material
     CHECK(r.status == 1);
     CHECK(r.err == u + ":1:8: error: unknown name 'r' here: it is defined below, at line 2 (a let takes effect from its line on; "
                        "move it above its first use)\nsphere(r);\n       ^\n");
+}
+
+TEST_CASE("names bound nowhere are shown 20 at a time, each with its nearest name, then counted") {
+    std::string text;
+    for (int i = 0; i < 3000; ++i) text += "def g" + std::to_string(i) + "() = sphre(1);\n";
+    const std::string s = test::write_temp("warn_many.sdf", text + "sphere(1);\n");
+    auto r = run_sdfc("check " + q(s));
+    CHECK(r.status == 0);
+    CHECK(r.err.find(s + ":20:13: warning: unknown name 'sphre' (did you mean `sphere`?), in code that has not run") != std::string::npos);
+    CHECK(r.err.find(s + ":21:13: warning: 2980 more names bound nowhere, in code that has not run (this is the first)\n") != std::string::npos);
+    CHECK(r.err.find(":22:") == std::string::npos);
 }

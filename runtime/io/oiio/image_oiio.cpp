@@ -231,7 +231,22 @@ void oiio_check_image_output(const std::string& path, const std::string& format)
     (void)image_output_for(format_name(path, format));
 }
 
+void write_image_and_sides(const std::string& path, const Image& img, const WriteOptions& opt, std::vector<std::string>& sides);
+
+// A main picture that fails to write takes the side files this call wrote before it away:
+// no set of new planes beside an old (or no) picture.
 void oiio_write_image(const std::string& path, const Image& img, const WriteOptions& opt) {
+    std::vector<std::string> sides;
+    try {
+        write_image_and_sides(path, img, opt, sides);
+    } catch (...) {
+        std::error_code ec;
+        for (const std::string& side : sides) fs::remove(side, ec);
+        throw;
+    }
+}
+
+void write_image_and_sides(const std::string& path, const Image& img, const WriteOptions& opt, std::vector<std::string>& sides) {
     oiio_check_image_output(path, opt.format);  // before any side file: a bad main path changes nothing
     const std::string as = format_name(path, opt.format);
     const std::string ext = lower_ext(as);
@@ -270,7 +285,10 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
     if (opt.aov_side_files && !img.aovs.empty() && path == "-")
         throw std::runtime_error("AOV side files need a file name: write them with -o NAME, or to standard output as --format exr channels");
     if (opt.aov_side_files)
-        for (const auto& a : img.aovs) write_side_file(path, img, a);
+        for (const auto& a : img.aovs) {
+            write_side_file(path, img, a);
+            sides.push_back(aov_side_path(path, a.name));
+        }
 
     const int oc = nc == 2 ? 1 : nc;  // no grey+alpha
     std::vector<std::string> names(kRGBA, kRGBA + oc);
@@ -316,6 +334,10 @@ void oiio_write_image(const std::string& path, const Image& img, const WriteOpti
 }
 
 Image oiio_read_image(const std::string& path) {
+    // (a device or a FIFO never ends: /dev/zero kept a reader busy for good)
+    std::error_code ec;
+    if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
+        throw std::runtime_error("cannot read '" + path + "': not a regular file");
     auto in = OIIO::ImageInput::open(path);
     if (!in) {
         std::string e = OIIO::geterror();
