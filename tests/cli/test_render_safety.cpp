@@ -157,6 +157,11 @@ TEST_CASE("a main picture that fails to write takes its new side files away, mer
     CHECK(r.err.rfind("sdfc: error: cannot write '" + dir + "/x.jp2': ", 0) == 0);
     CHECK(!fs::exists(dir + "/x.depth.png"));
     CHECK(!fs::exists(dir + "/x.jp2"));
+    // A format that takes no RGB is found before the render (on a small picture), not after.
+    r = run_sdfc("render '" + s + "' -o '" + dir + "/y.zfile' --width 8 --height 8 --quiet");
+    CHECK(r.status == 1);
+    CHECK(r.err == "sdfc: error: cannot write '" + dir + "/y.zfile': Zfile only supports 1 channel, not 3\n");
+    CHECK(fs::is_empty(dir));
     // A band from /dev/zero never ends: refused before it is read.
     REQUIRE(run_sdfc("render '" + s + "' -o '" + dir + "/p1.exr' --tiles 1/2 --width 64 --height 64 --quiet").status == 0);
     r = run_sdfc("merge /dev/zero '" + dir + "/p1.exr' -o '" + dir + "/m.png'");

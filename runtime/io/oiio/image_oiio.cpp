@@ -14,6 +14,7 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <mutex>
 #include <filesystem>
 #include <stdexcept>
 #include <system_error>
@@ -101,9 +102,21 @@ void verify_file(const std::string& path, const std::string& file, int width, in
 // `as` names the format (the path itself, or "stdout.png" for standard output).
 // `row0` and `full_height` (> 0): the image is that band of a taller picture, written as
 // the EXR data window inside that picture's display window.
+std::vector<unsigned char> encode_checked(const std::string& path, const std::string& as, int width, int height,
+                                          const std::vector<std::string>& names, OIIO::TypeDesc type, const void* data, bool linear,
+                                          int row0, int full_height, const std::string& picture);
+
 void write_atomic(const std::string& path, const std::string& as, int width, int height, const std::vector<std::string>& names,
                   OIIO::TypeDesc type, const void* data, bool linear, int row0 = 0, int full_height = 0,
                   const std::string& picture = "") {
+    const std::vector<unsigned char> buf = encode_checked(path, as, width, height, names, type, data, linear, row0, full_height, picture);
+    write_file(path, std::string_view(reinterpret_cast<const char*>(buf.data()), buf.size()));
+}
+
+// write_atomic's encoding, decoded again: the bytes to write.
+std::vector<unsigned char> encode_checked(const std::string& path, const std::string& as, int width, int height,
+                                          const std::vector<std::string>& names, OIIO::TypeDesc type, const void* data, bool linear,
+                                          int row0, int full_height, const std::string& picture) {
     if (width <= 0 || height <= 0) throw std::runtime_error(write_error(path, "the image is empty"));
     OIIO::ImageSpec spec(width, height, static_cast<int>(names.size()), type);
     if (full_height > 0) {
@@ -152,7 +165,7 @@ void write_atomic(const std::string& path, const std::string& as, int width, int
         buf.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
         if (in.bad() || buf.empty()) throw std::runtime_error(write_error(path, "cannot read back the encoded image"));
     }
-    write_file(path, std::string_view(reinterpret_cast<const char*>(buf.data()), buf.size()));
+    return buf;
 }
 
 // An AOV plane's EXR channel names: Z, N.x N.y N.z, steps.Y (a layer of one channel).
@@ -228,7 +241,20 @@ std::string format_name(const std::string& path, const std::string& format) {
 
 void oiio_check_image_output(const std::string& path, const std::string& format) {
     resolve_output(path);
-    (void)image_output_for(format_name(path, format));
+    const std::string as = format_name(path, format);
+    (void)image_output_for(as);
+    // A format outside the usual ones is tried on a small picture before any work: some
+    // take no RGB at all (zfile holds one channel) and failed only after the render.
+    static const char* const kUsual[] = {".png", ".jpg", ".jpeg", ".exr", ".hdr", ".tif", ".tiff", ".bmp", ".tga", ".ppm", ".pgm"};
+    const std::string ext = lower_ext(as);
+    if (std::find(std::begin(kUsual), std::end(kUsual), ext) != std::end(kUsual)) return;
+    static std::mutex m;
+    static std::vector<std::string> tried;  // (once per format: a batch checks every frame)
+    std::lock_guard<std::mutex> lock(m);
+    if (std::find(tried.begin(), tried.end(), ext) != tried.end()) return;
+    const std::vector<uint8_t> grey(64 * 64 * 3, 128);
+    (void)encode_checked(path, as, 64, 64, {"R", "G", "B"}, OIIO::TypeDesc::UINT8, grey.data(), false, 0, 0, "");
+    tried.push_back(ext);
 }
 
 void write_image_and_sides(const std::string& path, const Image& img, const WriteOptions& opt, std::vector<std::string>& sides);
