@@ -70,7 +70,8 @@ constexpr size_t kTreeWorkPerInstr = 64, kTreeWorkBase = size_t(16) << 10, kTree
 // children 0.6-0.8 of their parent's length): uncapped, its build made 757 leaves of
 // 94,000 instructions, 1.1 GB, and took 4.9 s of a 7.2 s render at 64 x 48; capped, 50
 // leaves, 0.5 s of 1.9 s. The examples make at most 2.7 M (vases.sdf), the 10,000-sphere
-// grid 0.8 M: the cap leaves them as they were.
+// grid 0.8 M: the cap leaves them as they were. A round reserves what its children may
+// make: 8 x their parent's length, times the share kept by the children made so far.
 constexpr size_t kTreeMadeBase = size_t(8) << 20, kTreeMadePerInstr = 32;
 constexpr uint32_t kNone = 0xFFFFFFFFu;
 
@@ -178,11 +179,15 @@ public:
         while (!queue_.empty() && round_.size() < kTreeRound && cells_.size() + 8 * (round_.size() + 1) <= max_nodes_) {
             const uint32_t i = ~queue_.top().second;
             const size_t len = cells_[i].tape.code.size();
-            // (8 x len: what the children's tapes may take, before they are known)
-            if (work_ + len > budget_ || made_ + reserved + 8 * len > made_cap_) break;
-            reserved += 8 * len;
+            // (what the children's tapes may take, before they are known: 8 x len times the
+            // share of their parents' length the children made so far have kept)
+            const double keep = split_ ? std::clamp(double(made_) / (8.0 * double(split_)), 0.125, 1.0) : 1.0;
+            const size_t expect = size_t(8.0 * double(len) * keep);
+            if (work_ + len > budget_ || made_ + reserved + expect > made_cap_) break;
+            reserved += expect;
             queue_.pop();
             work_ += len;
+            round_len_ += len;
             round_.push_back(i);
         }
         return !round_.empty();
@@ -200,6 +205,8 @@ public:
             TreeScratch& s = scratch_.local();
             for (size_t q = r.begin(); q != r.end(); ++q) split(s, round_[q]);
         });
+        split_ += round_len_;
+        round_len_ = 0;
         for (size_t q = 0; q < round_.size(); ++q)
             for (uint32_t k = 0; k < 8; ++k) {
                 made_ += cells_[first_child_[round_[q]] + k].tape.code.size();
@@ -235,7 +242,9 @@ private:
     const size_t made_cap_;
     const size_t max_nodes_;
     size_t work_ = 0;
-    size_t made_ = 0;  // instructions of the tapes made, against made_cap_
+    size_t made_ = 0;   // instructions of the tapes made, against made_cap_
+    size_t split_ = 0;  // ... and of their parents'
+    size_t round_len_ = 0;  // (the parents' of the round taken)
     bool checked_ = false;
     std::deque<TreeCell> cells_ = std::deque<TreeCell>(1);  // a deque: growing moves nothing
     std::vector<uint32_t> first_child_ = std::vector<uint32_t>(1, kNone);

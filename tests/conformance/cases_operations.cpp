@@ -153,6 +153,17 @@ void add_operation_cases(std::vector<Case>& out) {
     s.script("polar_repeat(4) union { translate([1, 0, 0.5]) sphere(0.2); translate([1.5, 0, 0]) sphere(0.1); }", 3)
         .random_bound(pair, far(pair), 1e-4, 3, 300, 7, 1e-4);
     s.script("polar_repeat(6) translate([2, 0, 0]) sphere(0.3);").at(2, 0, 0, -0.3);
+    // A smooth union of 8 or more operands blends through a select (the same floats): ten
+    // spheres in a row against Quilez's chain in doubles.
+    s.script("smooth_union(0.3) { for (i = [0 : 9]) translate([i * 0.5 - 2.25, 0, 0]) sphere(0.2); }", 3)
+        .random([](double x, double y, double z) {
+            double acc = sph(x, y, z, -2.25, 0.2);
+            for (int i = 1; i < 10; ++i) {
+                const double b = sph(x, y, z, i * 0.5 - 2.25, 0.2), h = std::max(0.3 - std::fabs(acc - b), 0.0) / 0.3;
+                acc = std::min(acc, b) - h * h * 0.3 * 0.25;
+            }
+            return acc;
+        }, 3, 300, 1e-5, 11);
     // A child that a param moves (in GLSL a uniform; here at its default): the cells move with
     // it, so its copies are whole (they were cut at the faces of cells laid out for 0).
     std::vector<std::array<double, 3>> mc;

@@ -147,3 +147,25 @@ TEST_CASE("spatial union: pruned as a whole, a small box keeps the spheres near 
     vm.eval(whole.view(), xs, ys, zs, kBatch);
     for (int i = 0; i < kBatch; ++i) CHECK(std::bit_cast<uint32_t>(vm.output(whole.view())[i]) == std::bit_cast<uint32_t>(ev.output(0)[i]));
 }
+
+TEST_CASE("a long smooth union drops its far operands whole from a pruned tape", "[union][interval]") {
+    // 10 x 10 spheres 1.6 apart (radius 0.56), blended by 0.1: around one sphere's centre
+    // every other operand is proved more than k away. Each used to leave 6 instructions
+    // computing 0 (the blend's h); now the blend is a select and goes with its operand.
+    const std::string src = "smooth_union(0.1) {\n" + grid(10, false) + "}\n";
+    auto c = test::compile_text(src);
+    const float cell = 1.6f;
+    REQUIRE(c->cs.distance.code.size() > 1000);
+    for (int i : {0, 3, 9})
+        for (int j : {0, 5, 9}) {
+            INFO("sphere " << i << ", " << j);
+            const float x = (float(i) + 0.5f) * cell - 8, y = 0.35f * cell, z = (float(j) + 0.5f) * cell - 8;
+            const Tape t = tape_for_box(c->cs, x, y, z, 0.4f);
+            CHECK(t.code.size() < 30);
+            Evaluator full(c->cs.distance);
+            BatchVM vm(64);
+            const float px[1] = {x + 0.1f}, py[1] = {y}, pz[1] = {z - 0.05f};
+            vm.eval(t.view(), px, py, pz, 1, 0.0f);
+            CHECK(vm.output(t.view())[0] == full.eval1(px[0], py[0], pz[0], 0.0f));
+        }
+}
