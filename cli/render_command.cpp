@@ -164,9 +164,12 @@ int cmd_render(Args& a) {
     // written: an error at any frame leaves no output at all (LANGUAGE.md section 9).
     // A picture already there is complete (written whole or not at all): --skip-existing
     // leaves it (a re-run task, a farm's retry).
+    // (An empty file is none of ours, which are written whole: made by `touch`, or a tool
+    // that failed. It is rendered.)
     auto present = [&](const std::string& target) {
         std::error_code ec;
         if (target == "-" || !std::filesystem::is_regular_file(target, ec)) return false;
+        if (std::filesystem::file_size(target, ec) == 0 || ec) return false;
         if (!is_exr(target))
             for (const std::string& av : ro.aovs)
                 if (!std::filesystem::is_regular_file(aov_side_path(target, av), ec)) return false;

@@ -115,6 +115,12 @@ TEST_CASE("shards together are the one-process render byte for byte, a re-run wr
     CHECK(fs::last_write_time(png + "/f0.png") == t0);
     CHECK(fs::exists(png + "/f1.png"));
     CHECK(fs::exists(png + "/f2.depth.png"));
+    // An empty file (a `touch`, a failed tool) is no picture of ours: rendered.
+    { std::ofstream(png + "/f1.png", std::ios::trunc); }
+    r = run_sdfc("render " + q(s) + pflags + " --skip-existing");
+    CHECK(r.status == 0);
+    CHECK(r.err.find("sdfc: wrote " + png + "/f1.png") != std::string::npos);
+    CHECK(fs::file_size(png + "/f1.png") > 0);
 }
 
 TEST_CASE("render --tiles bands and sdfc merge make the one-render picture, byte for byte") {
