@@ -144,7 +144,7 @@ CompileError::CompileError(Loc loc, std::string message)
 
 // Well-formed UTF-8 (Unicode table 3-7): no overlong forms, surrogates or code points
 // above U+10FFFF.
-static bool valid_utf8(std::string_view s, size_t& bad_at) {
+bool valid_utf8(std::string_view s, size_t& bad_at) {
     size_t i = 0;
     while (i < s.size()) {
         unsigned char c = static_cast<unsigned char>(s[i]);

@@ -64,6 +64,8 @@ private:
 
 // Throws CompileError at the first NUL byte (a binary file) or invalid UTF-8 sequence.
 void check_source_text(const SourceFile& f);
+// Well-formed UTF-8; else false, with the offset of the first bad byte.
+bool valid_utf8(std::string_view s, size_t& bad_at);
 
 // Owns every loaded file so Locs stay valid for the whole compilation.
 // Every path SourceManager::load or load_stdin was asked for (by any manager) since the

@@ -42,11 +42,18 @@ std::string vec3_lit(float x, float y, float z) {
 }
 
 // The script's name, for the header comment.
-std::string script_name(const Scene& s) {
+// The script's file name, as it is (`raw`, for the html page's title: UTF-8 when the name
+// is) or fit for a GLSL comment (ASCII).
+std::string script_name(const Scene& s, bool raw = false) {
+    auto fit = [&](const std::string& path) {
+        const std::string name = std::filesystem::path(path).filename().string();
+        size_t bad = 0;
+        return raw && valid_utf8(name, bad) ? name : glsl::comment_text(name);
+    };
     for (Loc l : {s.root ? s.root->loc : Loc{}, s.camera.loc, s.render.loc})
-        if (l.file) return glsl::comment_text(std::filesystem::path(l.file->path).filename().string());
+        if (l.file) return fit(l.file->path);
     for (const LightSettings& l : s.lights)
-        if (l.loc.file) return glsl::comment_text(std::filesystem::path(l.loc.file->path).filename().string());
+        if (l.loc.file) return fit(l.loc.file->path);
     return "scene";
 }
 
@@ -58,7 +65,8 @@ glm::vec3 const3(const Graph& g, const Vec3N& v, glm::vec3 dflt) {
 }
 
 struct Parts {
-    std::string name;       // script file name
+    std::string name;       // script file name (for a GLSL comment)
+    std::string title;      // ... as it is (the html page's)
     std::string code;       // everything but the entry point (no #version, no uniforms)
     bool uses_time = false;
     bool tape = false;
@@ -130,6 +138,7 @@ Parts generate(const Scene& scene, const GlslOptions& options, glsl::TapeStorage
 
     Parts out;
     out.name = script_name(scene);
+    out.title = script_name(scene, true);
     out.uses_time = dist.uses_time || mat.uses_time || set.uses_time;
     std::string& c = out.code;
     c += fmt::format(
@@ -392,7 +401,7 @@ std::string target_text(const Parts& p, GlslTarget target) {
             s += "\n";
             s += glsl::kPageMain;
             if (target == GlslTarget::HtmlShader) return s;
-            return glsl::html_page(p.name, s, scene_json(p), false, p.tape_words);
+            return glsl::html_page(p.title, s, scene_json(p), false, p.tape_words);
         }
     }
     return {};
