@@ -284,6 +284,9 @@
   [['samples', 'samples'], ['steps', 'steps'], ['bounces', 'bounces']].forEach(function (k) {
     document.getElementById(k[0]).addEventListener('change', function (e) { knobs[k[1]] = parseInt(e.target.value, 10); dirty = true; });
   });
+  // A param's value as its slider shows it: a whole number as it is (a count reads 6, not
+  // 6.00), else 3 significant digits without trailing zeros.
+  function shown(v) { v = Number(v); return Number.isInteger(v) ? String(v) : String(Number(v.toPrecision(3))); }
   // The script's parameters (param name = value in [lo, hi]): a slider each, a uniform each.
   function buildControls() {
     tlabel.title = scene.uses_time ? '' : 'This scene does not depend on time';
@@ -296,10 +299,10 @@
       input.min = String(p.min); input.max = String(p.max); input.step = String(p.step);
       input.value = String(paramValues[p.name]);
       input.setAttribute('data-param', p.name);
-      out.textContent = ' ' + Number(paramValues[p.name]).toPrecision(3);
+      out.textContent = shown(paramValues[p.name]);
       input.addEventListener('input', function () {
         paramValues[p.name] = parseFloat(input.value);
-        out.textContent = ' ' + Number(paramValues[p.name]).toPrecision(3);
+        out.textContent = shown(paramValues[p.name]);
         dirty = true;
       });
       label.appendChild(document.createTextNode(p.name + ' '));
