@@ -103,7 +103,12 @@ int Args::to_int(const std::string& flag, const std::string& v, long lo, long hi
 float Args::to_float(const std::string& flag, const std::string& v) {
     char* end = nullptr;
     float x = std::strtof(v.c_str(), &end);
-    if (v.empty() || *end != '\0' || !std::isfinite(x)) throw UsageError(fmt::format("{} takes a number, not '{}'", flag, v));
+    if (v.empty() || *end != '\0') throw UsageError(fmt::format("{} takes a number, not '{}'", flag, v));
+    // (a number past a float's range is named as such, not as no number, or as 0 where it underflows)
+    const double d = std::strtod(v.c_str(), nullptr);
+    if (std::isfinite(d) && (!std::isfinite(x) || (x == 0.0f && d != 0.0)))
+        throw UsageError(fmt::format("{} {}: the number is {} for a float (sdfc computes in floats)", flag, v, x == 0.0f ? "too small" : "too large"));
+    if (!std::isfinite(x)) throw UsageError(fmt::format("{} takes a number, not '{}'", flag, v));
     return x;
 }
 

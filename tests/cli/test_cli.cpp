@@ -62,6 +62,13 @@ TEST_CASE("a number out of range is quoted as typed, and {name} of standard inpu
     auto r = run_sdfc("render '" + s + "' --width 99999999999999999999 -o '" + test::temp_dir() + "/range.png'");
     CHECK(r.status == 2);
     CHECK(r.err == "sdfc: error: --width must be from 1 to 16384, not 99999999999999999999\n");
+    // Past a float's range either way: named so, not "not a number", nor "must be positive" of a 0.
+    r = run_sdfc("render '" + s + "' --frames 0:1 --fps 1e-300 -o '" + test::temp_dir() + "/range{frame}.png'");
+    CHECK(r.status == 2);
+    CHECK(r.err == "sdfc: error: --fps 1e-300: the number is too small for a float (sdfc computes in floats)\n");
+    r = run_sdfc("render '" + s + "' --time 1e300 -o '" + test::temp_dir() + "/range.png'");
+    CHECK(r.status == 2);
+    CHECK(r.err == "sdfc: error: --time 1e300: the number is too large for a float (sdfc computes in floats)\n");
     const std::string out = test::temp_dir() + "/{name}.png";
     auto in = run_sdfc("render - --width 8 --height 8 -q -o '" + out + "'", "", s);
     CHECK(in.status == 0);
