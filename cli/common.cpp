@@ -160,15 +160,16 @@ void progress_line(const std::string& target, double frac, double elapsed_s, dou
 void read_points(const std::string& path, size_t max_bytes, std::vector<float>& xs, std::vector<float>& ys, std::vector<float>& zs) {
     // A bad line is an error in an input file: path:line:col, the line and a caret, exit 1.
     const SourceFile file(path == "-" ? "<stdin>" : path, read_bounded(path, max_bytes));  // (-: standard input)
+    // "x y z", or "x,y,z" as --at takes it (a CSV file); a byte-order mark first is skipped.
     for (uint32_t ln = 1; ln <= file.line_starts.size(); ++ln) {
         const std::string_view line = file.line(ln);
         float v[3];
-        size_t pos = 0;
+        size_t pos = ln == 1 && line.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
         int k = 0;
         for (;; ++k) {
-            pos = line.find_first_not_of(" \t\r", pos);
+            pos = line.find_first_not_of(k > 0 ? " \t\r," : " \t\r", pos);
             if (pos == std::string_view::npos) break;
-            const size_t end = std::min(line.find_first_of(" \t\r", pos), line.size());
+            const size_t end = std::min(line.find_first_of(" \t\r,", pos), line.size());
             std::istringstream ts{std::string(line.substr(pos, end - pos))};
             float f = 0.0f;
             if (k == 3 || !(ts >> f) || ts.peek() != std::char_traits<char>::eof())

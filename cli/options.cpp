@@ -113,7 +113,7 @@ std::vector<CommandSpec> make_commands() {
     c.push_back({"eval", "SCENE (--at X,Y,Z | --points FILE)", "print the distance at points, one per line",
                  {
                      {"--at", "", "X,Y,Z", "", "", "one point"},
-                     {"--points", "", "FILE", "FILE", "", "a file of points, \"x y z\" per line (-: standard input)"},
+                     {"--points", "", "FILE", "FILE", "", "a file of points, \"x y z\" or \"x,y,z\" per line (-: standard input)"},
                      time,
                  },
                  "", true});

@@ -100,6 +100,11 @@ TEST_CASE("eval prints one distance per line") {
     CHECK(r4.err.rfind(word + ":2:4: error: expected three numbers \"x y z\"\n", 0) == 0);
     std::string many = test::write_temp("pts_many.txt", "1 2 3 4\n");
     CHECK(run_sdfc("eval '" + s + "' --points '" + many + "'").err.rfind(many + ":1:7: error: expected three numbers \"x y z\", not more\n", 0) == 0);
+    // Commas as --at takes them (a CSV file), after a byte-order mark too.
+    std::string csv = test::write_temp("pts.csv", "\xEF\xBB\xBF" "2,0,0\n0, 5, 0\n");
+    auto r5 = run_sdfc("eval '" + s + "' --points '" + csv + "'");
+    CHECK(r5.status == 0);
+    CHECK(r5.out == "0\n4\n");
 }
 
 TEST_CASE("check reports script errors with a caret and exit 1") {
