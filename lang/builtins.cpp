@@ -595,6 +595,17 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
             warn(m.loc, fmt::format("this {} has one operand: it cuts nothing away (a second shape is missing?)", m.name));
         else if (meet && s.children.size() == 1)
             warn(m.loc, fmt::format("this {} has one operand: it is that shape (a second shape is missing?)", m.name));
+        // An if whose condition is false, or a for without iterations, is an empty operand:
+        // as the first of a difference, or in an intersection, it empties the whole.
+        if ((cut || meet) && s.children.size() > 1)
+            for (size_t i = 0; i < (cut ? 1 : s.children.size()); ++i) {
+                const Shape& c = *s.children[i];
+                if (c.kind == ShapeKind::Empty || (c.kind == ShapeKind::Union && c.children.empty())) {
+                    warn(c.loc, fmt::format("this operand of the {} adds no shape (a false condition, a loop without "
+                                            "iterations): the {} is empty", m.name, m.name));
+                    break;
+                }
+            }
     };
     switch (m.id) {
         case B::Rotate: {

@@ -195,3 +195,18 @@ TEST_CASE("names bound nowhere are shown 20 at a time, each with its nearest nam
     CHECK(r.err.find(s + ":21:13: warning: 2980 more names bound nowhere, in code that has not run (this is the first)\n") != std::string::npos);
     CHECK(r.err.find(":22:") == std::string::npos);
 }
+
+TEST_CASE("an empty operand that empties a difference or an intersection is a warning") {
+    const std::string s = test::write_temp("warn_empty_operand.sdf",
+                                           "let n = 0;\n"
+                                           "difference { for (i = [1 : n]) box(1); sphere(1); }\n"
+                                           "difference { sphere(1); for (i = [1 : n]) box(1); }\n"
+                                           "intersection { sphere(2); if (n > 0) box(1); }\n");
+    auto r = run_sdfc("check " + q(s));
+    CHECK(r.status == 0);
+    CHECK(r.err == s + ":2:14: warning: this operand of the difference adds no shape (a false condition, a loop without iterations): "
+                       "the difference is empty\ndifference { for (i = [1 : n]) box(1); sphere(1); }\n             ^\n" +
+                       s + ":4:27: warning: this operand of the intersection adds no shape (a false condition, a loop without "
+                           "iterations): the intersection is empty\nintersection { sphere(2); if (n > 0) box(1); }\n"
+                           "                          ^\n");
+}
