@@ -404,9 +404,29 @@ Value Interp::call_user(const Callable& fn, const std::vector<ast::Arg>& args, E
         }
         callenv->vars[p.name] = Binding{values[i], false, p.loc};
     }
-    Value r = eval(*def.value, callenv);
+    Value r;
+    try {
+        r = eval(*def.value, callenv);
+    } catch (CompileError& e) {
+        throw called_from(e, fn, loc);
+    }
     release_envs(mark);
     return r;
+}
+
+// An error inside a def's body names the call it came from (the innermost one: the values
+// the body was given), unless it is one of the whole script's limits.
+CompileError Interp::called_from(const CompileError& e, const Callable& fn, Loc call) {
+    std::vector<Diagnostic> d = e.diagnostics();
+    if (d.empty() || !call.known()) return e;
+    std::string& m = d.back().message;
+    const Loc& at = d.back().loc;
+    if (m.find("(raise it with --max-") != std::string::npos || m.find(", called at ") != std::string::npos ||
+        (at.file == call.file && at.line == call.line && at.col == call.col))
+        return e;
+    m += call.file == at.file || !call.file ? fmt::format(" (in {}, called at line {})", fn.name, call.line)
+                                            : fmt::format(" (in {}, called at {}:{})", fn.name, call.file->path, call.line);
+    return CompileError(std::move(d));
 }
 
 // Whether a call of `fn` with `args` leaves its last parameter, one without a default, to

@@ -122,6 +122,7 @@ public:
     Value call_value(const Value& callee, const std::vector<ast::Arg>& args, Env* env, Loc loc);
     // `last`: the value of the last parameter when no argument gives it (a user modifier's target).
     Value call_user(const Callable& fn, const std::vector<ast::Arg>& args, Env* env, Loc loc, const Value* last = nullptr);
+    CompileError called_from(const CompileError& e, const Callable& fn, Loc call);
     Value apply(const ast::Expr& e, Env* env);
     // Runs body once per combination of the bindings (the first varies slowest), each in a
     // fresh scope; enforces the loop limits.

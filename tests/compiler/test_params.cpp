@@ -79,7 +79,7 @@ TEST_CASE("params: what a script cannot do with them") {
           "param(1, 0.1, 3);");
     CHECK(test::first_error_line("def f(r) = sphere(param(r));\nf(1);") ==
           "test.sdf:1:19: error: param(...) gives a top-level let its value, which the html page's slider turns: let size = "
-          "param(1, 0.1, 3);");
+          "param(1, 0.1, 3); (in f, called at line 2)");
     CHECK(test::first_error_line("let r = param(5, 0, 1);\nsphere(r);") == "test.sdf:1:15: error: the param's value 5 is outside [0, 1]");
     CHECK(test::first_error_line("let r = param(0.5, 1, 0);\nsphere(r);") ==
           "test.sdf:1:23: error: the param's max (0) must be above its min (1)");

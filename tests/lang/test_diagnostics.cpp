@@ -164,3 +164,10 @@ TEST_CASE("an index must be a whole number within the vector or list") {
     CHECK(first_error_line("sphere([1, 2, 3][1.5]);") == "test.sdf:1:18: error: index 1.5 is not a whole number");
     CHECK(first_error_line("sphere([1, 2, 3][3]);") == "test.sdf:1:18: error: index 3 is out of range for a 3-component vector");
 }
+
+TEST_CASE("an error inside a def names the call it came from, the innermost") {
+    CHECK(first_error_line("def opRep(p, c) = mod(p + 0.5 * c, c) - 0.5 * c;\nfield (q) -> length(opRep(q, [3, 0, 3])) - 1;") ==
+          "test.sdf:1:36: error: mod by zero (in opRep, called at line 2)");
+    CHECK(first_error_line("def inner(r) = sphere(-r);\ndef outer(r) = inner(r);\nouter(1);") ==
+          "test.sdf:1:23: error: argument 'r' of sphere must be zero or positive, not -1 (in inner, called at line 2)");
+}
