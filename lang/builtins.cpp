@@ -597,15 +597,11 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
             warn(m.loc, fmt::format("this {} has one operand: it is that shape (a second shape is missing?)", m.name));
         // An if whose condition is false, or a for without iterations, is an empty operand:
         // as the first of a difference, or in an intersection, it empties the whole.
-        if ((cut || meet) && s.children.size() > 1)
-            for (size_t i = 0; i < (cut ? 1 : s.children.size()); ++i) {
-                const Shape& c = *s.children[i];
-                if (c.kind == ShapeKind::Empty || (c.kind == ShapeKind::Union && c.children.empty())) {
-                    warn(c.loc, fmt::format("this operand of the {} adds no shape (a false condition, a loop without "
-                                            "iterations): the {} is empty", m.name, m.name));
-                    break;
-                }
-            }
+        const auto none = [](const ShapePtr& c) { return c->kind == ShapeKind::Empty || (c->kind == ShapeKind::Union && c->children.empty()); };
+        const auto last = cut && s.children.size() > 1 ? s.children.begin() + 1 : s.children.end();  // (a difference: its first)
+        const auto hit = std::find_if(s.children.begin(), last, none);
+        if ((cut || meet) && s.children.size() > 1 && hit != last)
+            warn((*hit)->loc, fmt::format("this operand of the {} adds no shape (a false condition, a loop without iterations): the {} is empty", m.name, m.name));
     };
     switch (m.id) {
         case B::Rotate: {
