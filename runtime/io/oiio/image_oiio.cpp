@@ -362,8 +362,8 @@ void write_image_and_sides(const std::string& path, const Image& img, const Writ
 Image oiio_read_image(const std::string& path) {
     // (a device or a FIFO never ends: /dev/zero kept a reader busy for good)
     std::error_code ec;
-    if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
-        throw std::runtime_error("cannot read '" + path + "': not a regular file");
+    const fs::file_status st = fs::status(path, ec);  // (one look, as SourceManager::read's)
+    if (!ec && fs::exists(st) && !fs::is_regular_file(st)) throw std::runtime_error("cannot read '" + path + "': not a regular file");
     auto in = OIIO::ImageInput::open(path);
     if (!in) {
         std::string e = OIIO::geterror();
