@@ -41,8 +41,13 @@ void check_picture_output(const std::string& out, const std::string& format) {
     } catch (const UsageError&) {
         throw;
     } catch (const std::runtime_error& e) {
-        if (out != "-") throw;
         const std::string m = e.what();
+        // An extension that names no image format is the command line's mistake (exit 2, as
+        // mesh's); a folder that is missing or read-only is not.
+        if (out != "-" && (m.find("': unknown image format '") != std::string::npos ||
+                           m.find("': no extension to choose the image format") != std::string::npos))
+            throw UsageError(m);
+        if (out != "-") throw;
         const size_t at = m.find("': ");
         throw UsageError(fmt::format("--format {}: {}", format, at == std::string::npos ? m : m.substr(at + 3)));
     }

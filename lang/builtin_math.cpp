@@ -236,10 +236,16 @@ Value Interp::make_param(std::vector<Value>& args, const std::vector<Loc>& locs,
         v[i] = const_num(args[i], locs[i], kWhat[i]);
         if (!std::isfinite(v[i])) fail(locs[i], fmt::format("{} is not a finite number", kWhat[i]));
     }
-    const float value = v[0], span = std::max(std::fabs(value), 1.0f);
-    const float lo = args.size() > 1 ? v[1] : value - span, hi = args.size() > 2 ? v[2] : value + span;
+    float value = v[0];
+    const float span = std::max(std::fabs(value), 1.0f);
+    float lo = args.size() > 1 ? v[1] : value - span, hi = args.size() > 2 ? v[2] : value + span;
     if (!(lo < hi)) fail(args.size() > 2 ? locs[2] : loc, fmt::format("the param's max ({}) must be above its min ({})", hi, lo));
     if (value < lo || value > hi) fail(locs[0], fmt::format("the param's value {} is outside [{}, {}]", value, lo, hi));
+    if (param_start) {  // glsl -D NAME=VALUE: the slider starts there, its range grown to hold it
+        value = *param_start;
+        lo = std::min(lo, value);
+        hi = std::max(hi, value);
+    }
     // By default the power of ten at most a thousandth of the range: whole numbers (and
     // tenths...) lie on the slider's grid, as a count or a `-D` value needs.
     const float step = args.size() > 3 ? v[3] : std::pow(10.0f, std::floor(std::log10((hi - lo) / 1000.0f)));

@@ -180,6 +180,8 @@ public:
     std::string param_let;
     int params_in_let = 0;     // param(...) calls in param_let's value: one names its slider
     bool param_fixed = false;  // -D gave the let its value: param(...) is a number
+    // glsl's -D on `let n = param(...)`: the slider stays and starts at -D's value.
+    std::optional<float> param_start;
     Value make_param(std::vector<Value>& args, const std::vector<Loc>& locs, Loc loc);
 
     SourceManager& sm;

@@ -237,6 +237,24 @@ Value Interp::defined_value(size_t k, const ast::Stmt& let, Env* env) {
         if (v.t != own.t || v.n != own.n)
             throw DefineError(fmt::format("{}: the script's '{}' (line {}) is {}, not {}", what, d.name, let.name_loc.line, describe(own),
                                           describe(v)));
+        // In a shader a let that is a param keeps its slider, which starts at -D's value.
+        const ast::Expr& e = *let.value;
+        const bool is_param = e.kind == ast::ExprKind::Call && e.callee && e.callee->kind == ast::ExprKind::Ident && e.callee->text == "param";
+        if (!opts.time && is_param && v.t == VT::Number && g->is_const(v.c[0])) {
+            param_let = let.name;
+            params_in_let = 0;
+            param_start = g->const_value(v.c[0]);
+            try {
+                own = eval(e, env);
+            } catch (...) {
+                param_let = outer;
+                param_start.reset();
+                throw;
+            }
+            param_let = outer;
+            param_start.reset();
+            return own;
+        }
         return v;
     } catch (const CompileError& e) {
         const auto& diags = e.diagnostics();

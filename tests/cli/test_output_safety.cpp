@@ -145,7 +145,7 @@ TEST_CASE("a character device or FIFO output is written through and a symlink st
         REQUIRE(::stat(full.c_str(), &st) == 0);
         CHECK(S_ISCHR(st.st_mode));
         r = run_sdfc("render " + q(s) + " -o " + q(full) + " --width 8 --height 8");
-        CHECK(r.status == 1);
+        CHECK(r.status == 2);
         CHECK(r.err.find("cannot write '" + full + "': no extension") != std::string::npos);
         REQUIRE(::stat(full.c_str(), &st) == 0);
         CHECK(S_ISCHR(st.st_mode));
@@ -296,10 +296,10 @@ TEST_CASE("the output path and format are checked before the work naming the use
     CHECK(r.status == 1);
     CHECK(r.err == "sdfc: error: cannot write '" + dir + "/nosuch/x.png': folder '" + dir + "/nosuch': No such file or directory\n");
     r = run_sdfc("render " + q(bad) + " -o " + q(dir + "/x.foo"));
-    CHECK(r.status == 1);
+    CHECK(r.status == 2);  // a command-line mistake, as mesh's unknown format
     CHECK(r.err.find("sdfc: error: cannot write '" + dir + "/x.foo': unknown image format '.foo'") == 0);
     r = run_sdfc("slice " + q(bad) + " --axis z --at 0 -o " + q(dir + "/noext"));
-    CHECK(r.status == 1);
+    CHECK(r.status == 2);
     CHECK(r.err.find("sdfc: error: cannot write '" + dir + "/noext': no extension") == 0);
     r = run_sdfc("render " + q(bad) + " --frames 0:3 -o " + q(dir + "/nosuch/f{frame:04d}.png"));
     CHECK(r.status == 1);

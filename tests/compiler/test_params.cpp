@@ -73,6 +73,24 @@ TEST_CASE("params: GLSL reads them from sdf_param[]") {
           std::string::npos);
 }
 
+TEST_CASE("params: glsl's -D sets where a param's slider starts, and the slider stays") {
+    SourceManager sm;
+    const SourceFile& f = sm.add("scene.sdf", kTwo + std::string("let r = 2 * param(1);\nsphere(r);\n"));
+    InterpretOptions o;
+    o.time = std::nullopt;
+    o.defines = {{"size", "1"}, {"lift", "3"}, {"r", "5"}};
+    const Scene s = interpret_source(sm, f, o);
+    REQUIRE(s.params.size() == 2);  // r is computed from its param: -D gives r its value, a number
+    CHECK(s.params[0].name == "size");
+    CHECK(s.params[0].value == 1.0f);
+    CHECK(s.params[0].min == 0.2f);
+    CHECK(s.params[0].max == 1.5f);
+    CHECK(s.params[1].value == 3.0f);  // beyond the script's [-0.5, 1]: the range grows to hold it
+    CHECK(s.params[1].max == 3.0f);
+    CHECK(s.params[1].step == 0.25f);
+    CHECK(emit_glsl(s, GlslTarget::Shadertoy).find("#define SDF_PARAM_size 1.0  // in [0.2, 1.5]; line 1") != std::string::npos);
+}
+
 TEST_CASE("params: what a script cannot do with them") {
     CHECK(test::first_error_line("sphere(param(1));") ==
           "test.sdf:1:8: error: param(...) gives a top-level let its value, which the html page's slider turns: let size = "
