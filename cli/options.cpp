@@ -138,7 +138,7 @@ std::vector<CommandSpec> make_commands() {
                      {"--resolution", "", "N", "", fmt::format("{}", m.resolution), "cells along the longest side of the box"},
                      {"--cell", "", "SIZE", "", "", "the cell size instead of --resolution"},
                      {"--bounds", "", "X0,Y0,Z0,X1,Y1,Z1", "", "found from the scene", "the box meshed (the solid is cut by it)"},
-                     {"--simplify", "", "TOL", "", "", "fewer triangles, every one within TOL of the surface"},
+                     {"--simplify", "", "TOL", "", "", "fewer triangles, checked to stay within TOL of the surface"},
                      time,
                      threads,
                      {"--max-triangles", "", "N", "", fmt::format("{}", m.max_triangles), "refuse meshes with more triangles"},

@@ -3,6 +3,7 @@
 // stages that make the bricks (bricks.cpp): classify and sample them, wake the skipped
 // neighbours the surface reaches, flip the pinched faces.
 #pragma once
+#include <cfloat>
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
@@ -107,12 +108,16 @@ struct Scratch {
             for (int j = 0; j < m; ++j) {
                 const float b = g.box(x[i + j], y[i + j], z[i + j]);
                 f[i + j] = r[j] < b ? b : r[j];  // NaN stays NaN: outside
+                if (b >= 0.0f && !(f[i + j] > 0.0f)) f[i + j] = FLT_MIN;  // the box's faces close the mesh
             }
         }
     }
 };
 
-inline bool inside(float v) { return v < 0.0f; }
+// A sample exactly on the surface counts as inside: where two solids touch on a grid plane
+// (a box standing on a floor plane, two boxes side by side) the samples between them read 0
+// and must join them, not leave two shells. The grid's outer layer is outside the box: > 0.
+inline bool inside(float v) { return v <= 0.0f; }
 
 // The cells around each sign-changing edge of b (offsets -1 and 0 in the other two axes).
 template <typename F>

@@ -34,7 +34,9 @@ constexpr uint32_t kGone = ~0u;
 constexpr size_t kRound = 1024;  // collapses asked of the field at once
 constexpr size_t kGrain = 32;   // of them per task
 constexpr size_t kMaxValence = 40;          // keeps fans, and the checks on them, small
-constexpr size_t kSlot = 2 * kMaxValence + 8;  // room for one collapse's probes, or its requeued edges
+constexpr size_t kSlot = 2 * kMaxValence + 8;  // room for one collapse's requeued edges
+constexpr size_t kProbesPerTriangle = 5;       // the centroid, the new edge's middle, three inner points
+constexpr size_t kProbeSlot = 1 + kProbesPerTriangle * (kMaxValence + 2);  // one collapse's probes
 constexpr float kMinTurn = 0.2f;            // cosine: a triangle may turn by up to ~78 degrees
 constexpr float kSliver = 0.05f;
 constexpr int kPasses = 3;     // the queue made again from every edge at most this often
@@ -326,8 +328,12 @@ private:
         return Take::Taken;
     }
 
-    // The centroid only where the surface may sag away from a new triangle: by the angle θ
-    // between its corners' normals over its longest edge L, an arc's L θ / 8.
+    // Where a new triangle may leave the surface: its centroid, and, unless the triangle is
+    // too small to sag by a quarter of the tolerance, the middle of the new edge after the
+    // moved vertex (each new edge is that of one triangle) and three points between the
+    // centroid and its corners (a triangle bridging a gap or a crease strays inside, not
+    // only at the centroid). The sag is bounded by the longest edge L and the angle θ
+    // between the corners' normals, an arc's L θ / 8.
     size_t probes(const Collapse& c, glm::vec3* out) const {
         size_t count = 0;
         out[count++] = c.p;
@@ -347,16 +353,16 @@ private:
                                                        glm::dot(p[0] - p[2], p[0] - p[2])}));
                 const float cos_min = std::min({glm::dot(n[0], n[1]), glm::dot(n[1], n[2]), glm::dot(n[2], n[0])});
                 const float theta = std::acos(std::clamp(cos_min, -1.0f, 1.0f));
-                if (!(len * theta * 0.125f <= kSag * tol_)) out[count++] = (p[0] + p[1] + p[2]) / 3.0f;
-                // The middle of the new edge after the moved vertex (each new edge is that of
-                // one triangle): a surface curving along it sags most there.
+                const bool flat = len * theta * 0.125f <= kSag * tol_ && len <= tol_;
                 for (int k = 0; k < 3; ++k) {
                     if (t[size_t(k)] != x) continue;
                     const int e = (k + 1) % 3;
-                    const float edge = glm::length(p[e] - p[k]);
-                    const float turn = std::acos(std::clamp(glm::dot(n[k], n[e]), -1.0f, 1.0f));
-                    if (!(edge * turn * 0.125f <= kSag * tol_)) out[count++] = 0.5f * (p[k] + p[e]);
+                    if (!flat) out[count++] = 0.5f * (p[k] + p[e]);
                 }
+                const glm::vec3 centre = (p[0] + p[1] + p[2]) / 3.0f;
+                out[count++] = centre;
+                if (!flat)
+                    for (int k = 0; k < 3; ++k) out[count++] = 0.5f * (centre + p[k]);
             }
         return count;
     }
@@ -370,7 +376,7 @@ private:
     bool near_surface(const Dual& d) const {
         const float g = std::sqrt(d.dx * d.dx + d.dy * d.dy + d.dz * d.dz);
         const float dist = std::fabs(d.v) / (g > 1e-6f ? g : 1.0f);
-        return dist <= 0.9f * tol_;  // (a tenth kept for what lies between the probes) NaN: not
+        return dist <= 0.85f * tol_;  // (kept for what lies between the probes) NaN: not
     }
 
     // Returns the collapses of u's edges to queue, in out (kSlot at most).
@@ -430,7 +436,7 @@ private:
         ++st.rounds;
         const size_t n = chosen.size();
         // Fixed slots per collapse, kept from round to round (only their counts are reset).
-        slots_.resize(std::max(slots_.size(), n * kSlot));
+        slots_.resize(std::max(slots_.size(), n * kProbeSlot));
         requeue_.resize(std::max(requeue_.size(), n * kSlot));
         std::vector<glm::vec3>& slots = slots_;
         std::vector<Queued>& requeue = requeue_;
@@ -439,13 +445,13 @@ private:
             for (size_t i = r.begin(); i < r.end(); ++i) {
                 Collapse& c = chosen[i];
                 c = plan(c.u, c.v);
-                if (allowed(c)) count[i] = probes(c, &slots[i * kSlot]);
+                if (allowed(c)) count[i] = probes(c, &slots[i * kProbeSlot]);
             }
         });
         std::vector<size_t> first(n + 1, 0);
         for (size_t i = 0; i < n; ++i) first[i + 1] = first[i] + count[i];
         std::vector<glm::vec3> pts(first[n]);
-        for (size_t i = 0; i < n; ++i) std::copy_n(slots.data() + i * kSlot, count[i], pts.data() + first[i]);
+        for (size_t i = 0; i < n; ++i) std::copy_n(slots.data() + i * kProbeSlot, count[i], pts.data() + first[i]);
         std::vector<Dual> d(pts.size());
         field_(pts.data(), pts.size(), d.data());
         std::vector<uint8_t> make(n, 0);

@@ -2,6 +2,9 @@
 // bounds, or the intervals' for a custom field, floors left out; none for what is unbounded.
 #include <catch2/catch.hpp>
 
+#include <set>
+#include <vector>
+
 #include "mesh_checks.hpp"
 #include "support.hpp"
 
@@ -123,4 +126,37 @@ TEST_CASE("auto box: a floor at the rest's bounds is a base at a coarse resoluti
         CHECK(x1 == Approx(o.hi.x));
         CHECK(bad_edges(m) == 0);
     }
+}
+
+TEST_CASE("mesh: solids that touch on a grid plane are one piece (a box on a floor, two boxes side by side)", "[mesh]") {
+    // The samples on the plane between them read 0: they join the solids, not part them.
+    auto pieces = [](const mesh::Mesh& m) {
+        std::vector<uint32_t> up(m.positions.size());
+        for (uint32_t i = 0; i < up.size(); ++i) up[i] = i;
+        auto root = [&](uint32_t x) {
+            while (up[x] != x) x = up[x] = up[up[x]];
+            return x;
+        };
+        for (const auto& t : m.triangles) up[root(t[0])] = root(t[1]), up[root(t[1])] = root(t[2]);
+        std::set<uint32_t> roots;
+        for (const auto& t : m.triangles) roots.insert(root(t[0]));
+        return roots.size();
+    };
+    auto floor = compile_text("translate([0, 1, 0]) box(2); plane();");
+    for (int res : {20, 32, 64}) {
+        INFO("resolution " << res);
+        mesh::MeshOptions o;
+        o.resolution = res;
+        REQUIRE(mesh::default_box(floor->cs, o.lo, o.hi, 0.0f, 8192, res));
+        const mesh::Mesh m = mesh::mesh_scene(floor->cs, o);
+        CHECK(pieces(m) == 1);
+        CHECK(bad_edges(m) == 0);
+    }
+    auto bar = compile_text("box(1); translate([1, 0, 0]) box(1);");
+    mesh::MeshOptions o;
+    o.lo = glm::vec3(-0.75f, -0.75f, -0.75f), o.hi = glm::vec3(1.75f, 0.75f, 0.75f);
+    o.resolution = 20;  // cells of 0.125: x = 0.5 is a grid plane
+    const mesh::Mesh m = mesh::mesh_scene(bar->cs, o);
+    CHECK(pieces(m) == 1);
+    CHECK(volume(m) == Approx(2.0).epsilon(0.01));
 }
