@@ -293,7 +293,11 @@ Lowered smooth(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited,
             r.closer_a = l.lt(sa, sb);
         } else {
             NodeId k = P(s, 0);
-            NodeId h = l.div(l.mx(l.sub(k, l.abs(l.sub(sa, sb))), l.c(0)), k);
+            // A k known only when the program runs (time, a param) may reach 0 or below: the
+            // divisor stays above 0, so h is 0 there and the blend the hard operation (0 / 0
+            // was NaN in the shader, which drew nothing).
+            const NodeId kd = g.is_const(k) ? k : l.mx(k, l.c(1e-30f));
+            NodeId h = l.div(l.mx(l.sub(k, l.abs(l.sub(sa, sb))), l.c(0)), kd);
             r.d = l.sub(l.mn(sa, sb), l.mul(l.mul(l.sq(h), k), l.c(0.25f)));
             // Many operands: the same floats (h is 0 where gap >= k) as a select, so that where
             // intervals prove the operands k apart the blend's code is dropped whole and a far
@@ -302,7 +306,7 @@ Lowered smooth(L& l, const Shape& s, const Vec3N& p, const MaterialN* inherited,
             // instructions, now 1,471 of 78,289). Two more instructions an operand, so not for
             // the usual few (showcase.sdf 1.06x the time, csg-tori.sdf 1.05x).
             if (s.children.size() >= kSelectedBlends) r.d = l.sel(l.lt(l.abs(l.sub(sa, sb)), k), r.d, l.mn(sa, sb));
-            r.blend = l.clamp(l.add(l.c(0.5f), l.div(l.mul(l.c(0.5f), l.sub(sa, sb)), k)), l.c(0), l.c(1));
+            r.blend = l.clamp(l.add(l.c(0.5f), l.div(l.mul(l.c(0.5f), l.sub(sa, sb)), kd)), l.c(0), l.c(1));
         }
         if (op != Sides::Union) r.d = l.neg(r.d);
         return r;

@@ -164,6 +164,12 @@ void add_operation_cases(std::vector<Case>& out) {
             }
             return acc;
         }, 3, 300, 1e-5, 11);
+    // A blend size at or below 0 is the hard operation, also when it is known only as the
+    // program runs (a param: in GLSL a uniform; 0 / 0 was NaN there, and the shader drew nothing).
+    s.script("let k = param(0, 0, 1);\nsmooth_union(k) { translate([-0.5, 0, 0]) sphere(0.5); translate([0.5, 0, 0]) box(0.8); }")
+        .at(0, 0, 0, 0).at(0, 1, 0, 0.6082763f, 1e-5).at(-1.5f, 0, 0, 0.5f, 1e-5);
+    s.script("let k = param(0, 0, 1);\nsmooth_difference(k) { box(1); sphere(0.6); }").at(0, 0, 0, 0.6f, 1e-5).at(0.5f, 0.5f, 0.5f, 0, 1e-5);
+    s.script("smooth_union(-0.2) { sphere(1); translate([1.5, 0, 0]) sphere(1); }").at(0.75f, 0, 0, -0.25f, 1e-5);
     // A child that a param moves (in GLSL a uniform; here at its default): the cells move with
     // it, so its copies are whole (they were cut at the faces of cells laid out for 0).
     std::vector<std::array<double, 3>> mc;
