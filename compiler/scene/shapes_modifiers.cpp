@@ -344,7 +344,11 @@ Lowered lower_PolarRepeat(L& l, const Shape& s, const Vec3N& p, const MaterialN*
         const NodeId dy = cb.lo.y > -1e29f && cb.hi.y < 1e29f
                               ? l.mx(l.mx(l.sub(l.c(cb.lo.y), p[1]), l.sub(p[1], l.c(cb.hi.y))), l.c(0.0f))
                               : l.c(0.0f);
-        acc->d = l.mn(acc->d, l.len2(l.mul(r, g.unary(Op::Sin, d)), dy));
+        // (nor nearer than the copies' ring: every copy lies at least rmin from the axis, so
+        // a point near the axis, where r sin(d) is 0, is not taken for a surface)
+        const float rmin = std::hypot(std::max({cb.lo.x, -cb.hi.x, 0.0f}), std::max({cb.lo.z, -cb.hi.z, 0.0f}));
+        const NodeId across = rmin > 0.0f ? l.mx(l.mul(r, g.unary(Op::Sin, d)), l.sub(l.c(rmin), r)) : l.mul(r, g.unary(Op::Sin, d));
+        acc->d = l.mn(acc->d, l.len2(across, dy));
     }
     return *acc;
 }
