@@ -34,6 +34,7 @@ Common read_common(Args& a) {
     }
     if (auto v = a.value("--max-calls")) l.max_calls = size_t(Args::to_int("--max-calls", *v, 1, 2000000000));
     if (auto v = a.value("--max-shapes")) l.max_shapes = size_t(Args::to_int("--max-shapes", *v, 1, 2000000000));
+    if (auto v = a.value("--max-list")) l.max_list = size_t(Args::to_int("--max-list", *v, 1, 2000000000));
     if (auto v = a.value("--max-shape-depth")) l.max_shape_depth = Args::to_int("--max-shape-depth", *v, 1, 10000);
     if (auto v = a.value("--max-ops")) l.max_ops = size_t(Args::to_int("--max-ops", *v, 1, 2000000000));
     if (auto v = a.value("--max-file-size")) l.max_file_bytes = size_t(Args::to_int("--max-file-size", *v, 1, 2000000000));
@@ -43,7 +44,10 @@ Common read_common(Args& a) {
     // -D name=value (OpenSCAD's flag): the script's top-level `let name` takes the value.
     for (const std::string& d : a.values("-D")) {
         const size_t eq = d.find('=');
-        const std::string name = d.substr(0, eq);
+        // (OpenSCAD's -D takes spaces around the '=': -D 'x = 2')
+        std::string name = d.substr(0, eq);
+        while (!name.empty() && (name.back() == ' ' || name.back() == '\t')) name.pop_back();
+        while (!name.empty() && (name.front() == ' ' || name.front() == '\t')) name.erase(0, 1);
         bool ident = !name.empty() && !std::isdigit(static_cast<unsigned char>(name[0]));
         for (char ch : name) ident &= std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
         if (eq == std::string::npos || !ident || eq + 1 == d.size())

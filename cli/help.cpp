@@ -215,7 +215,7 @@ std::string global_help() {
     s += wrap(kScenes, 0, 100);
     s += wrap("Every command that reads a scene takes -D NAME=VALUE (the script's top-level `let NAME` takes VALUE, as "
               "OpenSCAD's -D) and the safety limits --max-recursion, --max-iterations, --max-calls, --max-shapes, "
-              "--max-shape-depth, --max-ops, --max-file-size, --max-nesting, --max-pixels, --max-frames.",
+              "--max-shape-depth, --max-list, --max-ops, --max-file-size, --max-nesting, --max-pixels, --max-frames.",
               0, 100);
     s += wrap(kConventions, 0, 100);
     return s;

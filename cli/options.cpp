@@ -209,6 +209,7 @@ const std::vector<Option>& scene_options() {
             lim("--max-calls", l.max_calls, "calls, field bodies and shapes applied to points, all together"),
             lim("--max-shapes", l.max_shapes, "shapes built"),
             lim("--max-shape-depth", l.max_shape_depth, "depth of the shape tree"),
+            lim("--max-list", l.max_list, "elements of one list"),
             lim("--max-ops", l.max_ops, "IR nodes"),
             Option{"--max-file-size", "", "BYTES", "", fmt::format("{}", l.max_file_bytes), "bytes of one source file"},
             lim("--max-nesting", l.max_nesting, "syntax nesting; a modifier and its block count 2"),

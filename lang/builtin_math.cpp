@@ -25,6 +25,9 @@ Value Interp::call_math(const BuiltinInfo& info, std::vector<Value>& args, const
         return Value::number(gr.constant(float(n)));
     }
     if (info.id == B::Concat) {  // OpenSCAD's: lists and vectors give their elements, anything else itself
+        size_t total = 0;  // (counted first: the copies are what costs)
+        for (const Value& a : args) total += a.t == VT::Vector ? a.n : a.t == VT::List ? a.list->size() : 1;
+        check_list_size(total, loc);
         std::vector<Value> items;
         for (const Value& a : args) {
             if (a.t == VT::Vector)

@@ -98,6 +98,7 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                         if (x.block) {
                             Value v = eval_block(*x.block, body, false);
                             if (v.t != VT::None) items.push_back(std::move(v));
+                            check_list_size(items.size(), e.loc);
                         } else {
                             generate(*x.body, body);
                         }
@@ -113,6 +114,7 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                 Value v = eval(x, scope);
                 if (v.t == VT::None) return;
                 items.push_back(std::move(v));
+                check_list_size(items.size(), e.loc);
             };
             for (const auto& el : e.elems) {
                 if (el->kind == K::For) {
@@ -518,6 +520,7 @@ Value Interp::list_value(std::vector<Value> items, Loc loc) {
         return Value::vector(c, int(items.size()));
     }
     // ([x] is a list of one number)
+    check_list_size(items.size(), loc);
     Value v;
     v.t = VT::List;
     v.depth = 1;

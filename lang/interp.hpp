@@ -164,6 +164,7 @@ public:
     ShapePtr make_shape(Shape s);
     std::string describe(const Value& v);
     void check_limit_iterations(long n, Loc loc);
+    void check_list_size(size_t n, Loc loc);
     void count_calls(size_t n, Loc loc);  // function calls, field bodies, shapes applied to points
 
     // -D: the main script's top-level env, which defines were used, and the override.

@@ -97,6 +97,11 @@ void Interp::check_limit_iterations(long n, Loc loc) {
                               opts.limits.max_total_iterations));
 }
 
+void Interp::check_list_size(size_t n, Loc loc) {
+    if (n > opts.limits.max_list)
+        fail(loc, fmt::format("a list of more than {} elements (raise it with --max-list)", opts.limits.max_list));
+}
+
 void Interp::count_calls(size_t n, Loc loc) {
     total_calls += n;
     if (total_calls > opts.limits.max_calls)

@@ -19,6 +19,7 @@ struct Limits {
     long max_loop_iterations = 100000;    // per for statement
     long max_total_iterations = 10000000; // all loops of a run together
     size_t max_shapes = 1000000;          // shapes built, and shapes in the scene tree (a shared one counts at each use)
+    size_t max_list = 1000000;            // elements of one list (a value is ~140 bytes: concat doubling a list ate GBs)
     size_t max_ops = 20000000;            // IR nodes
     int max_nesting = 1024;               // syntax nesting (parser): a modifier and its block count 2
     int max_shape_depth = 4000;           // depth of the shape tree

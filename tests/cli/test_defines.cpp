@@ -55,6 +55,8 @@ TEST_CASE("the flag -D: its errors are command-line errors, with did-you-mean") 
     CHECK(form.status == 2);
     CHECK(form.err == "sdfc: error: -D takes NAME=VALUE (a top-level let of the script and an expression), not 'size'\n");
     CHECK(run_sdfc("check " + q(s) + " -D size=1 -D size=2").err == "sdfc: error: -D size is given twice\n");
+    CHECK(run_sdfc("check " + q(s) + " -D 'size = 2'").status == 0);  // as OpenSCAD's -D
+    CHECK(run_sdfc("check " + q(s) + " -D 'size = 2' -D size=3").err == "sdfc: error: -D size is given twice\n");
     CHECK(run_sdfc("check " + q(s) + " -D \"$(printf 'size=\\377')\"").err == "sdfc: error: -D size: the value is not text (a NUL byte or invalid UTF-8)\n");
     CHECK(run_sdfc("check " + q(s) + " -D").err == "sdfc: error: -D needs a value\n");
     const std::string vm = test::write_temp("defines.vm", "_0 var-x\n_1 var-y\n_2 var-z\n_3 add _0 _1\n_4 add _3 _2\n");

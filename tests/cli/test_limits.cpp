@@ -65,6 +65,16 @@ TEST_CASE("flag --max-calls") {
     CHECK(check(s).first == 0);
 }
 
+TEST_CASE("flag --max-list (a list comprehension, concat)") {
+    // concat needs no loop or call: a list doubled 20 times took 1.4 GB before this limit.
+    std::string s = test::write_temp("lim_list.sdf", "let a = [for (i = [0 : 11]) i];\nlet b = concat(a, a);\nsphere(len(b) / 24);\n");
+    CHECK(check(s, "--max-list 10") == std::pair<int, std::string>{1, s + ":1:9: error: a list of more than 10 elements (raise it with --max-list)"});
+    CHECK(check(s, "--max-list 20") == std::pair<int, std::string>{1, s + ":2:9: error: a list of more than 20 elements (raise it with --max-list)"});
+    CHECK(check(s, "--max-list 24").first == 0);
+    CHECK(check(s).first == 0);
+    CHECK(check(s, "--max-list 0").second == "sdfc: error: --max-list must be from 1 to 2000000000, not 0");
+}
+
 TEST_CASE("flag --max-shapes and --max-shape-depth") {
     std::string s = test::write_temp("lim_shapes.sdf", "for (i = [0 : 199]) translate([i, 0, 0]) sphere(0.4);\n");
     auto [st, err] = check(s, "--max-shapes 100");
