@@ -320,7 +320,9 @@ Lowered lower_PolarRepeat(L& l, const Shape& s, const Vec3N& p, const MaterialN*
     // are evaluated too, and those left out are a floor: a point at radius r, an angle d from
     // their sectors, is at least r sin(min(d, pi / 2)) away.
     Graph& g = l.g;
-    NodeId n = P(s, PolarRepeatP::n);
+    // A count is whole, the part after the point dropped (a param's slider, -D n=2.5), as
+    // repeat's: the same on the CPU and in the shader.
+    NodeId n = l.mx(g.unary(Op::Floor, P(s, PolarRepeatP::n)), l.c(1.0f));
     NodeId ang = l.div(l.c(2 * kPi), n);
     const Bounds cb = shape_bounds(g, *s.children.at(0));
     PolarCopies pc;

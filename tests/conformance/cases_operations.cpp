@@ -153,6 +153,8 @@ void add_operation_cases(std::vector<Case>& out) {
     s.script("polar_repeat(4) union { translate([1, 0, 0.5]) sphere(0.2); translate([1.5, 0, 0]) sphere(0.1); }", 3)
         .random_bound(pair, far(pair), 1e-4, 3, 300, 7, 1e-4);
     s.script("polar_repeat(6) translate([2, 0, 0]) sphere(0.3);").at(2, 0, 0, -0.3);
+    // A count from a param is whole, the part after the point dropped (2.5: two copies).
+    s.script("let n = param(2.5, 1, 10);\npolar_repeat(n) translate([1, 0, 0]) sphere(0.2);").at(-1, 0, 0, -0.2f, 1e-5).at(0, 0, 1, 1.2142136f, 1e-5);
     // The copies left out are no nearer than their ring: on the axis a box's copies are 1.75
     // away (the floor r sin(d) alone was 0 there, and rays along the axis drew a line).
     s.script("polar_repeat(4) translate([2, 0, 0]) box(0.5);").at(0, 0, 0, 1.75f, 1e-5).at(0, 0.3f, 0, 1.7507142f, 1e-5).at(1e-6f, 0, 0, 1.75f, 1e-5);
