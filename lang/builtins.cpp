@@ -173,6 +173,12 @@ struct Binder {
             const std::string_view pname = info.params[idx].name;
             if (v.t == VT::String && (pname == "color" || pname == "emission") && info.params[idx].type != PT::Any)
                 v = in.colour_name(*v.str, a.value->loc);
+            // OpenSCAD's [x, y] for a move, a mirror or a scale (2D profiles): z is 0, or 1 to scale.
+            const std::string_view fn = info.name;
+            if (idx == 0 && v.t == VT::Vector && v.n == 2 && (fn == "translate" || fn == "mirror" || fn == "scale")) {
+                v.c[2] = in.g->constant(fn == "scale" ? 1.0f : 0.0f);
+                v.n = 3;
+            }
             check_type(info.params[idx], v, a.value->loc);
             out.values[idx] = std::make_unique<Value>(std::move(v));
             out.locs[idx] = a.value->loc;
@@ -634,7 +640,8 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
         case B::Mirror: {
             s.kind = ShapeKind::Mirror;
             Vec3N n = v3(0, 0);
-            NodeId len = gr.ternary(Op::Length3, n[0], n[1], n[2]);
+            // A zero normal mirrors nothing, as in OpenSCAD (`for (m = [0, 1]) mirror([m, 0, 0])`).
+            NodeId len = gr.binary(Op::Max, gr.ternary(Op::Length3, n[0], n[1], n[2]), gr.constant(1e-30f));
             s.params = {gr.div(n[0], len), gr.div(n[1], len), gr.div(n[2], len)};
             s.children = {target};
             break;

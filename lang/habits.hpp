@@ -38,6 +38,17 @@ inline std::string habit_hint(std::string_view name) {
         {"str", "sdfc has no string functions: strings name colours and settings"},
         {"assert", "sdfc has no assert: a shape's arguments are checked where they are given"},
         {"undef", "sdfc has no undef: give a default value"},
+        {"text", "sdfc has no text(): shapes are distance functions, and fonts are not"},
+        {"polyhedron", "sdfc has no polyhedron(): build the solid from primitives, or extrude(h) polygon(points) for a prism"},
+        {"resize", "sdfc has no resize(): scale([sx, sy, sz]) by the ratio of the sizes"},
+        {"break", "sdfc has no break: loops unroll; guard the body instead, `if (going) { ... }`"},
+        {"continue", "sdfc has no continue: loops unroll; guard the body instead, `if (keep) { ... }`"},
+        {"iResolution", "a scene has no screen: `render(width, height)` or --width/--height; a field takes the point p"},
+        {"fragCoord", "a scene has no screen: a field takes the point p, `field (p) -> length(p) - 1`"},
+        {"iMouse", "no mouse in a scene: a `param(...)` gives the html page a slider"},
+        {"uniform", "a value the page turns is `let NAME = param(value, min, max);`"},
+        {"void", "sdfc has no types: a scene is shapes, `field (p) -> ...` for a custom distance"},
+        {"const", "sdfc has no types: `let a = 1.5;` (a let is constant)"},
     };
     for (const Habit& h : kHabits)
         if (h.name == name) return " (" + std::string(h.hint) + ")";
@@ -62,6 +73,7 @@ inline std::string openscad_argument_hint(std::string_view shape, std::string_vi
     if (shape == "rotate" && (param == "a" || param == "v"))
         return "sdfc's forms are rotate([x, y, z]) (degrees about x, then y, then z), rotate(angle, axis) and rotate(y = angle)";
     if (shape == "translate" && param == "v") return "give the vector alone, translate([x, y, z])";
+    if (shape == "extrude" && param == "height") return "the height is h, extrude(h = 2) (OpenSCAD's linear_extrude(height = 2))";
     return "";
 }
 

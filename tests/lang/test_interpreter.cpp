@@ -108,6 +108,22 @@ TEST_CASE("concat, lookup and norm, as OpenSCAD's") {
           "test.sdf:1:20: error: lookup's table holds [key, value] pairs of numbers; this pair holds a 2-component vector");
 }
 
+TEST_CASE("OpenSCAD's [x, y] moves, mirrors and scales, and a zero mirror normal that mirrors nothing") {
+    // Hole positions as 2D points: z is 0 (a scale's is 1).
+    const char* holes = "let holes = [[3, 0], [-3, 0]];\nextrude(1) difference { square(10); for (p = holes) translate(p) circle(1); }";
+    CHECK(close(dist_of(holes, 3, 0, 0), 1));
+    CHECK(close(dist_of(holes, -3, 0, 0), 1));
+    CHECK(close(dist_of("scale([2, 1]) sphere(1);", 0, 0, 1), 0));
+    CHECK(close(dist_of("mirror([1, 0]) translate([3, 0, 0]) sphere(1);", -3, 0, 0), -1));
+    // for (m = [0, 1]) mirror([m, 0, 0]): both copies.
+    const char* both = "for (m = [0, 1]) mirror([m, 0, 0]) translate([3, 0, 0]) sphere(1);";
+    CHECK(close(dist_of(both, 3, 0, 0), -1));
+    CHECK(close(dist_of(both, -3, 0, 0), -1));
+    CHECK(test::first_error_line("translate([1, 2]) rotate([1, 2]) sphere(1);") == "test.sdf:1:26: error: rotate([x, y, z]) takes a 3-component vector of angles");
+    CHECK(test::first_error_line("extrude(height = 2) circle(1);") ==
+          "test.sdf:1:9: error: extrude has no parameter 'height': the height is h, extrude(h = 2) (OpenSCAD's linear_extrude(height = 2))");
+}
+
 TEST_CASE("a script's own len, norm, concat, lookup or param (names the contract does not reserve) wins") {
     CHECK(close(dist_of("let len = 3; sphere(len);", 0, 0, 0), -3));
     CHECK(close(dist_of("def norm(v) = abs(v[0]) + abs(v[1]); sphere(norm([3, 4]));", 0, 0, 0), -7));
