@@ -124,7 +124,7 @@ int cmd_mesh(Args& a) {
             if (!(std::fabs(v) <= 1e15f)) throw UsageError("--bounds must lie within 1e15 of the origin on each axis");
     } else if (!mesh::default_box(cs, mo.lo, mo.hi, t, 8192, mo.resolution)) {
         if (!reads_point(cs.distance)) throw std::runtime_error(fmt::format("{} has no surface (its distance is the same everywhere): nothing to mesh", path));
-        throw UsageError("the scene is unbounded (a plane, an infinite repetition, shapes beyond 1e29?): give --bounds X0,Y0,Z0,X1,Y1,Z1");
+        throw UsageError("the scene is unbounded (a plane, an infinite repetition, a 2D profile not extruded: extrude(h) it, shapes beyond 1e29?): give --bounds X0,Y0,Z0,X1,Y1,Z1");
     } else if (!(glm::all(glm::lessThanEqual(glm::abs(mo.lo), glm::vec3(1e15f))) && glm::all(glm::lessThanEqual(glm::abs(mo.hi), glm::vec3(1e15f))))) {
         // (as --bounds: beyond, a float cannot place a vertex within a cell, and squares overflow)
         throw std::runtime_error(fmt::format("{} reaches beyond 1e15 of the origin ({} to {}): scale it down to mesh it", path,

@@ -174,11 +174,8 @@ struct Binder {
             if (v.t == VT::String && (pname == "color" || pname == "emission") && info.params[idx].type != PT::Any)
                 v = in.colour_name(*v.str, a.value->loc);
             // OpenSCAD's [x, y] for a move, a mirror or a scale (2D profiles): z is 0, or 1 to scale.
-            const std::string_view fn = info.name;
-            if (idx == 0 && v.t == VT::Vector && v.n == 2 && (fn == "translate" || fn == "mirror" || fn == "scale")) {
-                v.c[2] = in.g->constant(fn == "scale" ? 1.0f : 0.0f);
-                v.n = 3;
-            }
+            if (const std::string_view fn = info.name; idx == 0 && v.t == VT::Vector && v.n == 2 && (fn == "translate" || fn == "mirror" || fn == "scale"))
+                v.c[2] = in.g->constant(fn == "scale" ? 1.0f : 0.0f), v.n = 3;
             check_type(info.params[idx], v, a.value->loc);
             out.values[idx] = std::make_unique<Value>(std::move(v));
             out.locs[idx] = a.value->loc;
@@ -369,7 +366,7 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
         b.read(&s.params);
         if (s.kind == ShapeKind::Polygon) {
             // A list of at least 3 points [x, y], kept as x, y slots in turn.
-            if (!b.has(0)) fail(loc, "missing argument 'points' of polygon");
+            b.require(0);
             const Value& pts = b.val(0);
             if (pts.t != VT::List || !pts.list || pts.list->size() < 3)
                 fail(b.loc(0), fmt::format("polygon takes a list of 3 or more points [x, y], not {}", describe(pts)));
@@ -397,13 +394,13 @@ Value Interp::call_builtin(const BuiltinInfo& info, const std::vector<ast::Arg>&
         b.read(nullptr);  // validate eagerly so errors point at the call even before a target is seen
         m->args = std::make_shared<BoundArgs>(std::move(b.out));
         Value v;
-        v.t = VT::Modifier;
-        v.mod = m;
+        v.t = VT::Modifier, v.mod = m;
         return v;
     }
     if (info.kind == BuiltinKind::MaterialCtor) {
         MaterialN mat;
         if (info.id == B::Color) {
+            b.require(0);  // (color() alone is no colour)
             mat = default_material(gr);
             if (b.has(0) && b.val(0).t == VT::Shape && b.val(0).shape->kind == ShapeKind::Field && b.val(0).shape->field_rgb) {
                 // A colour that varies with the point: a modifier carrying the field's body.
@@ -640,8 +637,7 @@ ShapePtr Interp::apply_modifier(const ModifierVal& m, ShapePtr target, Loc loc) 
         case B::Mirror: {
             s.kind = ShapeKind::Mirror;
             Vec3N n = v3(0, 0);
-            // A zero normal mirrors nothing, as in OpenSCAD (`for (m = [0, 1]) mirror([m, 0, 0])`).
-            NodeId len = gr.binary(Op::Max, gr.ternary(Op::Length3, n[0], n[1], n[2]), gr.constant(1e-30f));
+            NodeId len = gr.binary(Op::Max, gr.ternary(Op::Length3, n[0], n[1], n[2]), gr.constant(1e-30f));  // 0: no mirror (OpenSCAD)
             s.params = {gr.div(n[0], len), gr.div(n[1], len), gr.div(n[2], len)};
             s.children = {target};
             break;

@@ -301,7 +301,7 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                 } depth{++call_depth};
                 const size_t mark = envs.size();
                 Env* fe = new_env(env, true);
-                fe->vars[param] = Binding{Value::vector(p.data(), 3), false, ploc};
+                fe->vars[param] = Binding{Value::vector(p.data(), 3), false, ploc, true};
                 Value v = eval(*body, fe);
                 release_envs(mark);
                 if (v.t != VT::Number) fail(body->loc, fmt::format("a field must compute a number (the distance), not {}", describe(v)));
@@ -311,7 +311,7 @@ Value Interp::eval(const ast::Expr& e, Env* env) {
                 count_calls(1, ploc);
                 const size_t mark = envs.size();
                 Env* fe = new_env(env, true);
-                fe->vars[param] = Binding{Value::vector(p.data(), 3), false, ploc};
+                fe->vars[param] = Binding{Value::vector(p.data(), 3), false, ploc, true};
                 Value v = eval(*body, fe);
                 release_envs(mark);
                 if (v.t != VT::Vector || v.n != 3)

@@ -20,6 +20,7 @@ struct Binding {
     Value value;
     bool mut = false;
     Loc loc;
+    bool field_param = false;  // a field's point (p in `field (p) -> ...`)
 };
 
 struct Env {

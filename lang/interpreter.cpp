@@ -281,6 +281,8 @@ void Interp::check_defines_used(Env* top) {
         for (const auto& [name, b] : top->vars)
             if (b.value.t != VT::Function) names.push_back(name);
         const std::string& n = opts.defines[k].name;
+        if (std::find(names.begin(), names.end(), n) != names.end())
+            throw DefineError(fmt::format("-D {}: '{}' is an imported file's let; -D sets the main script's own top-level lets", n, n));
         const std::string near = nearest_name(n, names);
         throw DefineError(near.empty() ? fmt::format("-D {}: the script has no top-level `let {}`", n, n)
                                        : fmt::format("-D {}: the script has no top-level `let {}` (did you mean `{}`?)", n, n, near));
@@ -411,6 +413,8 @@ void Interp::check_shape_before_shape(const ast::Expr& e) {
                 fail(s.name_loc, fmt::format("unknown variable '{0}' (a new name is declared with `let {0} = ...;`, or `var {0} = ...;` "
                                              "inside a field to change it later)",
                                              s.name));
+            if (!b->mut && env->field_scope && b->field_param)
+                fail(s.name_loc, fmt::format("'{0}' is the field's point, which does not change; copy it to change it: `var q = {0};`", s.name));
             if (!b->mut && env->field_scope)
                 fail(s.name_loc, fmt::format("'{}' is a constant (declared with let at line {}); declare it with var to reassign it", s.name, b->loc.line));
             if (!b->mut)  // (outside a field block nothing changes: OpenSCAD's rule too)

@@ -59,6 +59,11 @@ TEST_CASE("the flag -D: its errors are command-line errors, with did-you-mean") 
     CHECK(run_sdfc("check " + q(s) + " -D 'size = 2' -D size=3").err == "sdfc: error: -D size is given twice\n");
     CHECK(run_sdfc("check " + q(s) + " -D \"$(printf 'size=\\377')\"").err == "sdfc: error: -D size: the value is not text (a NUL byte or invalid UTF-8)\n");
     CHECK(run_sdfc("check " + q(s) + " -D").err == "sdfc: error: -D needs a value\n");
+    // A let of an imported file: -D names the main script's own.
+    test::write_temp("defines_lib.sdf", "let wall = 2;\n");
+    const std::string main = test::write_temp("defines_main.sdf", "import \"defines_lib.sdf\";\nsphere(wall);\n");
+    CHECK(run_sdfc("check " + q(main) + " -D wall=3").err ==
+          "sdfc: error: -D wall: 'wall' is an imported file's let; -D sets the main script's own top-level lets\n");
     const std::string vm = test::write_temp("defines.vm", "_0 var-x\n_1 var-y\n_2 var-z\n_3 add _0 _1\n_4 add _3 _2\n");
     auto model = run_sdfc("check " + q(vm) + " -D a=1");
     CHECK(model.status == 2);

@@ -72,7 +72,7 @@ TEST_CASE("mesh errors come before the work and change nothing") {
     CHECK(raised.status == 0);  // above the default limit and above what an int holds
     const std::string plane = test::write_temp("mesh_plane.sdf", "plane([0, 1, 0], 0);\n");
     CHECK(run_sdfc("mesh " + q(plane) + " -o a.stl").err ==
-          "sdfc: error: the scene is unbounded (a plane, an infinite repetition, shapes beyond 1e29?): give --bounds X0,Y0,Z0,X1,Y1,Z1\n");
+          "sdfc: error: the scene is unbounded (a plane, an infinite repetition, a 2D profile not extruded: extrude(h) it, shapes beyond 1e29?): give --bounds X0,Y0,Z0,X1,Y1,Z1\n");
     const std::string empty = test::write_temp("mesh_empty.sdf", "// nothing yet\n");
     auto none = run_sdfc("mesh " + q(empty) + " -o a.stl");
     CHECK(none.status == 1);
