@@ -151,6 +151,17 @@ void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
 Overrides read_overrides(Args& a) {
     Overrides ov;
     for (const char* f : kOverrideFlags) ov.emplace_back(f, a.value(f));
+    // Their ranges checked now, before a scene is read (watch stops on a bad flag: no save
+    // of the scene can fix --width 0); the scene's rules come with apply_overrides.
+    RenderSettings dry;
+    Args flat = flat_args(ov);
+    (void)apply_render_flags(dry, flat);
+    for (const char* f : {"--camera-position", "--camera-target"})
+        if (auto v = flat.value(f)) (void)Args::to_floats(f, *v, 3);
+    if (auto v = flat.value("--fov")) {
+        const float f = Args::to_float("--fov", *v);
+        if (!(f > 0 && f < 180)) throw UsageError("--fov must be between 0 and 180 degrees");
+    }
     return ov;
 }
 

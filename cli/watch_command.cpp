@@ -37,6 +37,10 @@ int cmd_watch(const std::vector<std::string>& args, int (*run)(const std::vector
             write_stdout(command_help(*find_command("watch")));
             return 0;
         }
+        if (a == "--") {  // (ends watch's options, as for every command)
+            ++i;
+            break;
+        }
         if (a != "--runs" && a != "--debounce") throw UsageError(fmt::format("unknown watch option '{}' (--runs N, --debounce MS, then the command)", a));
         if (i + 1 >= args.size()) throw UsageError(fmt::format("{} needs a value", a));
         if (a == "--runs") runs = Args::to_int("--runs", args[++i], 1, 1000000000);

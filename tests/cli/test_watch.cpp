@@ -91,4 +91,11 @@ TEST_CASE("watch's usage errors") {
     CHECK(wrong.status == 2);
     CHECK(wrong.err == "sdfc: error: render needs -o OUT\nsdfc: error: watch stops: the command line above is wrong, and no save of the scene "
                        "can fix it\n");
+    // A flag out of its range too (the scene was read before the flag was checked: it waited).
+    auto width = run_sdfc("watch render " + q(s) + " -o " + q(test::temp_dir() + "/watch_w.png") + " --width 0");
+    CHECK(width.status == 2);
+    CHECK(width.err == "sdfc: error: --width must be from 1 to 16384, not 0\nsdfc: error: watch stops: the command line above is wrong, and no save "
+                       "of the scene can fix it\n");
+    // -- ends watch's options.
+    CHECK(run_sdfc("watch --runs 1 -- check " + q(s)).status == 0);
 }
