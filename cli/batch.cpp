@@ -128,9 +128,8 @@ int cmd_merge(Args& a) {
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::sort(order.begin(), order.end(), [&](size_t x, size_t y) { return bands[x].row0 < bands[y].row0; });
     const Image& first = bands[order[0]];
-    Image img(first.width, first.full_height, first.channels);
-    for (const AovPlane& p : first.aovs)
-        img.aovs.push_back(AovPlane{p.name, p.channels, std::vector<float>(size_t(img.width) * img.height * size_t(p.channels))});
+    // The bands agree and cover the picture's rows before the picture is made: a header
+    // claiming a million rows makes nothing until the bands hold them.
     int next = 0;  // the first row not yet filled
     for (size_t k : order) {
         const Image& b = bands[k];
@@ -138,21 +137,28 @@ int cmd_merge(Args& a) {
         if (b.picture != first.picture)
             throw std::runtime_error(fmt::format("'{}' is a band of another picture than '{}' (another scene, frame, setting, AOV or N of --tiles I/N)", name,
                                                  parts[order[0]]));
-        if (b.width != img.width || b.full_height != img.height || b.channels != img.channels || b.aovs.size() != img.aovs.size())
+        if (b.width != first.width || b.full_height != first.full_height || b.channels != first.channels || b.aovs.size() != first.aovs.size())
             throw std::runtime_error(fmt::format("'{}' is a band of another picture ({}x{}, {} channels) than '{}' ({}x{}, {} channels)", name,
-                                                 b.width, b.full_height, b.channels, parts[order[0]], img.width, img.height, img.channels));
+                                                 b.width, b.full_height, b.channels, parts[order[0]], first.width, first.full_height, first.channels));
+        for (size_t i = 0; i < b.aovs.size(); ++i)
+            if (b.aovs[i].name != first.aovs[i].name) throw std::runtime_error(fmt::format("'{}' has other planes than the first band", name));
         if (b.row0 != next)
             throw std::runtime_error(b.row0 > next ? fmt::format("rows {} to {} are in none of the bands", next, b.row0 - 1)
                                                    : fmt::format("'{}' overlaps another band (rows {} to {})", name, b.row0, next - 1));
+        next = b.row0 + b.height;
+    }
+    if (next != first.full_height) throw std::runtime_error(fmt::format("rows {} to {} are in none of the bands", next, first.full_height - 1));
+    Image img(first.width, first.full_height, first.channels);
+    for (const AovPlane& p : first.aovs)
+        img.aovs.push_back(AovPlane{p.name, p.channels, std::vector<float>(size_t(img.width) * img.height * size_t(p.channels))});
+    for (size_t k : order) {
+        const Image& b = bands[k];
         std::copy(b.pixels.begin(), b.pixels.end(), img.pixels.begin() + std::ptrdiff_t(size_t(b.row0) * img.width * img.channels));
         for (size_t i = 0; i < img.aovs.size(); ++i) {
-            if (b.aovs[i].name != img.aovs[i].name) throw std::runtime_error(fmt::format("'{}' has other planes than the first band", name));
             const size_t at = size_t(b.row0) * img.width * size_t(b.aovs[i].channels);
             std::copy(b.aovs[i].data.begin(), b.aovs[i].data.end(), img.aovs[i].data.begin() + std::ptrdiff_t(at));
         }
-        next = b.row0 + b.height;
     }
-    if (next != img.height) throw std::runtime_error(fmt::format("rows {} to {} are in none of the bands", next, img.height - 1));
     write_image(*out, img, WriteOptions{true, fmt_ext});
     if (!quiet)
         std::fprintf(stderr, "sdfc: wrote %s (%dx%d from %zu band%s)\n", *out == "-" ? "standard output" : out->c_str(), img.width, img.height,

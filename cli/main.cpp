@@ -266,6 +266,13 @@ int cmd_slice(Args& a) {
     }
     if (w) so.width = Args::to_int("--width", *w, 1, 16384);
     if (h) so.height = Args::to_int("--height", *h, 1, 16384);
+    if (range && !h) {  // the height follows the range's shape: within the same limit as --height
+        const double rows = double(so.width) * (double((*so.range)[3]) - (*so.range)[2]) / (double((*so.range)[1]) - (*so.range)[0]);
+        if (!(rows <= 16384.5))
+            throw UsageError(fmt::format("--range is {:g} times as tall as wide: {:.4g} rows at --width {}, over 16384 (give --height: "
+                                         "the picture then shows more of the plane across)",
+                                         (double((*so.range)[3]) - (*so.range)[2]) / (double((*so.range)[1]) - (*so.range)[0]), rows, so.width));
+    }
     if (double(so.width) * so.height > double(c.max_pixels))
         throw UsageError(fmt::format("{}x{} pixels is over the limit of {} (raise it with --max-pixels)", so.width, so.height, c.max_pixels));
     check_picture_output(*out, fmt_ext);

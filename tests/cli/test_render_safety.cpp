@@ -146,7 +146,7 @@ TEST_CASE("a render killed with SIGKILL never leaves a partial output") {
     if (WIFSIGNALED(st)) CHECK(!fs::exists(out));
 }
 
-TEST_CASE("a main picture that fails to write takes its new side files away, merge refuses a device, slice clamps its rows") {
+TEST_CASE("a main picture that fails to write takes its new side files away, merge refuses a device, slice refuses rows past 16384") {
     const std::string dir = test::temp_dir() + "/sides";
     fs::remove_all(dir);
     fs::create_directories(dir);
@@ -167,9 +167,14 @@ TEST_CASE("a main picture that fails to write takes its new side files away, mer
     r = run_sdfc("merge /dev/zero '" + dir + "/p1.exr' -o '" + dir + "/m.png'");
     CHECK(r.status == 1);
     CHECK(r.err == "sdfc: error: cannot read '/dev/zero': not a regular file\n");
-    // A range 1e-30 wide and 2 tall is the tallest picture, not an int overflow's one row.
-    REQUIRE(run_sdfc("slice '" + s + "' --axis x --at 0 -o '" + dir + "/s.exr' --width 4 --range=-1e-30,1e-30,-1,1").status == 0);
-    CHECK(read_image(dir + "/s.exr").height == 16384);
+    // A range 1e-30 wide and 2 tall asks for more rows than --height allows: said, not an int
+    // overflow's one row, nor 16384 rows silently stretched; with --height it is drawn.
+    r = run_sdfc("slice '" + s + "' --axis x --at 0 -o '" + dir + "/s.exr' --width 4 --range=-1e-30,1e-30,-1,1");
+    CHECK(r.status == 2);
+    CHECK(r.err == "sdfc: error: --range is 1e+30 times as tall as wide: 4e+30 rows at --width 4, over 16384 (give "
+                   "--height: the picture then shows more of the plane across)\n");
+    REQUIRE(run_sdfc("slice '" + s + "' --axis x --at 0 -o '" + dir + "/s.exr' --width 4 --height 16 --range=-1e-30,1e-30,-1,1").status == 0);
+    CHECK(read_image(dir + "/s.exr").height == 16);
     r = run_sdfc("slice '" + s + "' --axis x --at 0 -o '" + dir + "/s.exr' --range=-3e38,3e38,-3e38,3e38");
     CHECK(r.status == 2);
     CHECK(r.err == "sdfc: error: --range must lie within 1e15 of the origin\n");
