@@ -91,7 +91,8 @@ Bounds bounds_RoundBox(const BoundsIn& b) { return sym(glm::abs(b.v3(RoundBoxP::
 Lowered lower_BoxFrame(L& l, const Shape& s, const Vec3N& p) {
     // Quilez's sdBoxFrame makes bars 2e thick; ours are `e` thick.
     Vec3N b = P3(s, BoxFrameP::size), a = l.abs3(p);
-    NodeId e = l.mul(P(s, BoxFrameP::e), l.half);
+    // Bars at most half the smallest side thick (then they fill the box), as round_box's radius.
+    NodeId e = l.mul(l.mn(P(s, BoxFrameP::e), l.mul(l.mn(l.mn(b[0], b[1]), b[2]), l.half)), l.half);
     Vec3N pp, q;
     for (int i = 0; i < 3; ++i) {
         pp[i] = l.sub(a[i], l.mul(b[i], l.half));

@@ -52,6 +52,8 @@ void add_primitive_cases(std::vector<Case>& out) {
     // box_frame: distance to the edges only. The face centre of a frame is open: the nearest
     // edge is at distance half - e along the face.
     s.script("box_frame(2, 0.1);").at(1, 0, 0, 0.9).at(2, 1, 1, 1);  // outside a corner edge, straight out
+    // Bars thicker than half the box fill it: the box (its outside exact, inside a bound).
+    s.script("box_frame(1, 0.6);").at(0.7f, 0, 0, 0.2f, 1e-5).at(0.7f, 0.7f, 0, 0.2828427f, 1e-5).at(0.4f, 0.4f, 0.4f, -0.1f, 1e-5);
     s.script("box_frame([2, 2, 2], 0.1);").random(ref3([](dv3 p) {
         dv3 b{1, 1, 1};
         double e = 0.05;  // half the bar thickness
