@@ -128,6 +128,16 @@ Value Interp::call_math(const BuiltinInfo& info, std::vector<Value>& args, const
         }
         case B::Min:
         case B::Max: {
+            if (args.size() == 1 && args[0].t == VT::List) {  // OpenSCAD's max([x]), max of a long list
+                const auto& items = *args[0].list;
+                if (items.empty()) fail(locs[0], fmt::format("{} of an empty list", info.name));
+                NodeId r = kNoNode;
+                for (const Value& x : items) {
+                    if (x.t != VT::Number) fail(locs[0], fmt::format("{} of a list takes numbers, not {}", info.name, describe(x)));
+                    r = r == kNoNode ? x.c[0] : gr.binary(info.id == B::Min ? Op::Min : Op::Max, r, x.c[0]);
+                }
+                return Value::number(r);
+            }
             if (args.size() == 1 && args[0].t == VT::Vector) {
                 NodeId r = args[0].c[0];
                 for (int i = 1; i < args[0].n; ++i) r = gr.binary(info.id == B::Min ? Op::Min : Op::Max, r, args[0].c[i]);

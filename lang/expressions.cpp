@@ -596,7 +596,10 @@ Value Interp::binary(ast::BinOp op, const Value& a, const Value& b, Loc loc) {
     }
     if (!arith_ok(a) || !arith_ok(b)) {
         const char* sym = op == B::Add ? "+" : op == B::Sub ? "-" : op == B::Mul ? "*" : op == B::Div ? "/" : "%";
-        fail(loc, fmt::format("cannot apply '{}' to {} and {}", sym, describe(a), describe(b)));
+        // `translate(v) %sphere(1)`, `rotate(a) *box(1)`: OpenSCAD's debug modifiers after a modifier.
+        const bool debug = (op == B::Mod || op == B::Mul) && b.t == VT::Shape;
+        fail(loc, fmt::format("cannot apply '{}' to {} and {}{}", sym, describe(a), describe(b),
+                              debug ? " (OpenSCAD's debug modifiers # % * ! have no use here: delete it)" : ""));
     }
     Op o = op == B::Add ? Op::Add : op == B::Sub ? Op::Sub : op == B::Mul ? Op::Mul : op == B::Div ? Op::Div : Op::Mod;
     return componentwise2(a, b, loc, [&](NodeId x, NodeId y) {

@@ -102,6 +102,8 @@ TEST_CASE("concat, lookup and norm, as OpenSCAD's") {
     CHECK(close(dist_of(f, 0, 0, 0), -1));
     CHECK(close(dist_of(f, 0, 0.5, 0), -0.75));
     CHECK(close(dist_of("sphere(norm([0, 3, 4]));", 0, 0, 0), -5));
+    CHECK(close(dist_of("sphere(max([1]) + min([5, 4, 3, 2, 0.5]));", 0, 0, 0), -1.5));  // max of a list, as OpenSCAD's
+    CHECK(test::first_error_line("sphere(max([]));") == "test.sdf:1:12: error: max of an empty list");
     CHECK(test::first_error_line("sphere(lookup(1, 2));") == "test.sdf:1:18: error: lookup's table is a list of [key, value] pairs, not a number");
     CHECK(test::first_error_line("sphere(lookup(1, []));") == "test.sdf:1:18: error: lookup's table is empty");
     CHECK(test::first_error_line("sphere(lookup(0.5, [[0, [0, 0]], [1, [1, 1]]]));") ==
