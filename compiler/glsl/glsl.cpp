@@ -302,6 +302,17 @@ std::string scene_json(const Parts& p) {
 
 // The script's params: uniforms the page's sliders set, or #defines at the top of a pasted
 // shader (a param's line names it in the script).
+// GLSL reserves names with "__" (SDF_PARAM__r for a param `_r`): those get their index and
+// single underscores, and the script's name stays in the comment.
+std::string param_define(const std::string& name, size_t i) {
+    if (name.find("__") == std::string::npos && name.front() != '_') return "SDF_PARAM_" + name;
+    std::string clean;
+    for (char c : name)
+        if (c != '_' || (!clean.empty() && clean.back() != '_')) clean += c;
+    while (!clean.empty() && clean.back() == '_') clean.pop_back();
+    return fmt::format("SDF_PARAM_{}{}{}", i, clean.empty() ? "" : "_", clean);
+}
+
 std::string param_block(const Parts& p, bool uniforms) {
     const size_t n = p.params.size();
     if (n == 0) return "";
@@ -310,9 +321,11 @@ std::string param_block(const Parts& p, bool uniforms) {
     std::string list;
     for (size_t i = 0; i < n; ++i) {
         const SceneParam& q = p.params[i];
-        s += fmt::format("#define SDF_PARAM_{} {}  // in [{}, {}]; line {}\n", q.name, literal(q.value), literal(q.min), literal(q.max),
+        const std::string define = param_define(q.name, i);
+        const std::string own = define == "SDF_PARAM_" + q.name ? "" : fmt::format("{} ", q.name);
+        s += fmt::format("#define {} {}  // {}in [{}, {}]; line {}\n", define, literal(q.value), own, literal(q.min), literal(q.max),
                          q.loc.line);
-        list += fmt::format("{}SDF_PARAM_{}", i ? ", " : "", q.name);
+        list += fmt::format("{}{}", i ? ", " : "", define);
     }
     s += fmt::format("const float sdf_param[{}] = float[{}]({});\n\n", n, n, list);
     return s;

@@ -91,6 +91,17 @@ TEST_CASE("params: glsl's -D sets where a param's slider starts, and the slider 
     CHECK(emit_glsl(s, GlslTarget::Shadertoy).find("#define SDF_PARAM_size 1.0  // in [0.2, 1.5]; line 1") != std::string::npos);
 }
 
+TEST_CASE("params: a name GLSL reserves (a '__' in its define) gets its index") {
+    SourceManager sm;
+    const Scene s = symbolic(sm, "let _r = param(1, 0.5, 2);\nlet my__r = param(1);\nlet ok_r = param(1);\nsphere(_r + my__r + ok_r);\n");
+    const std::string st = emit_glsl(s, GlslTarget::Shadertoy);
+    CHECK(st.find("#define SDF_PARAM_0_r 1.0  // _r in [0.5, 2.0]; line 1") != std::string::npos);
+    CHECK(st.find("#define SDF_PARAM_1_my_r 1.0  // my__r in") != std::string::npos);
+    CHECK(st.find("#define SDF_PARAM_ok_r 1.0  // in") != std::string::npos);
+    CHECK(st.find("SDF_PARAM__") == std::string::npos);  // (comments may quote the name)
+    CHECK(st.find("SDF_PARAM_my__r") == std::string::npos);
+}
+
 TEST_CASE("params: what a script cannot do with them") {
     CHECK(test::first_error_line("sphere(param(1));") ==
           "test.sdf:1:8: error: param(...) gives a top-level let its value, which the html page's slider turns: let size = "
