@@ -172,7 +172,24 @@ int cmd_check(Args& a) {
     c.keep_scene = true;
     std::string path = one_scene(a, "check");
     SourceManager sm;
-    build(sm, path, c, 0.0f);
+    try {
+        build(sm, path, c, 0.0f);
+    } catch (const CompileError& e) {
+        // An error only time 0 makes (`1 / time`, `mod(x, time)`): said, as `sdfc glsl`
+        // (time left open) takes the script.
+        InterpretOptions open = c.interp;
+        open.time = std::nullopt;
+        try {
+            SourceManager again;
+            const Scene s = load_scene(again, path, open);
+            (void)compile_scene(s);
+        } catch (const std::exception&) {
+            throw e;
+        }
+        std::vector<Diagnostic> d = e.diagnostics();
+        for (auto& x : d) x.message += " (at time 0, where check reads the script; other times may not fail: render --time T)";
+        throw CompileError(std::move(d));
+    }
     return 0;
 }
 

@@ -210,3 +210,14 @@ TEST_CASE("an empty operand that empties a difference or an intersection is a wa
                            "iterations): the intersection is empty\nintersection { sphere(2); if (n > 0) box(1); }\n"
                            "                          ^\n");
 }
+
+TEST_CASE("check says when only time 0 makes the error (glsl, time left open, takes the script)") {
+    const std::string s = test::write_temp("check_time0.sdf", "sphere(0.5 + 0.1 * sin(1 / time));\n");
+    auto r = run_sdfc("check " + q(s));
+    CHECK(r.status == 1);
+    CHECK(r.err.rfind(s + ":1:26: error: division by zero (at time 0, where check reads the script; other times may not fail: render --time T)\n", 0) == 0);
+    CHECK(run_sdfc("glsl " + q(s) + " -o " + q(test::temp_dir() + "/check_time0.glsl")).status == 0);
+    // An error at every time has no such note.
+    const std::string always = test::write_temp("check_always.sdf", "sphere(1 / 0);\n");
+    CHECK(run_sdfc("check " + q(always)).err.rfind(always + ":1:10: error: division by zero\n", 0) == 0);
+}
