@@ -111,15 +111,22 @@ TEST_CASE("auto box: a floor moved or turned by constants is a floor too", "[mes
     CHECK(blended.hi.x >= 1.3f);
 }
 
+namespace {
+// The scene meshed in its default box at `res` cells across; the box in o.
+mesh::Mesh mesh_in_default_box(const CompiledScene& cs, int res, mesh::MeshOptions& o) {
+    o.resolution = res;
+    REQUIRE(mesh::default_box(cs, o.lo, o.hi, 0.0f, 8192, res));
+    return mesh::mesh_scene(cs, o);
+}
+}  // namespace
+
 TEST_CASE("auto box: a floor at the rest's bounds is a base at a coarse resolution too", "[mesh]") {
     // The base is the margin below the sphere: at 32 cells, 2 % of the box is under a cell.
     auto c = compile_text("sphere(1); translate([0, -1, 0]) plane();");
     for (int res : {16, 32, 48}) {
         INFO("resolution " << res);
         mesh::MeshOptions o;
-        o.resolution = res;
-        REQUIRE(mesh::default_box(c->cs, o.lo, o.hi, 0.0f, 8192, res));
-        const mesh::Mesh m = mesh::mesh_scene(c->cs, o);
+        const mesh::Mesh m = mesh_in_default_box(c->cs, res, o);
         float x0 = INFINITY, x1 = -INFINITY;
         for (const glm::vec3& p : m.positions) x0 = std::min(x0, p.x), x1 = std::max(x1, p.x);
         CHECK(x0 == Approx(o.lo.x));  // the base reaches the box's sides
@@ -146,9 +153,7 @@ TEST_CASE("mesh: solids that touch on a grid plane are one piece (a box on a flo
     for (int res : {20, 32, 64}) {
         INFO("resolution " << res);
         mesh::MeshOptions o;
-        o.resolution = res;
-        REQUIRE(mesh::default_box(floor->cs, o.lo, o.hi, 0.0f, 8192, res));
-        const mesh::Mesh m = mesh::mesh_scene(floor->cs, o);
+        const mesh::Mesh m = mesh_in_default_box(floor->cs, res, o);
         CHECK(pieces(m) == 1);
         CHECK(bad_edges(m) == 0);
     }
