@@ -116,6 +116,12 @@ bool apply_render_flags(RenderSettings& r, Args& a) {
 
 }  // namespace
 
+static float fov_flag(const std::string& v) {  // (both the early check and apply_overrides)
+    const float f = Args::to_float("--fov", v);
+    if (!(f > 0 && f < 180)) throw UsageError("--fov must be between 0 and 180 degrees");
+    return f;
+}
+
 void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
     Args a = flat_args(ov);
     const bool sized = apply_render_flags(cs.render, a);  // the size comes from flags, not (only) from the script
@@ -127,11 +133,7 @@ void apply_overrides(CompiledScene& cs, const Overrides& ov, Common& c) {
         auto f = Args::to_floats("--camera-target", *v, 3);
         cs.camera.target = {f[0], f[1], f[2]};
     }
-    if (auto v = a.value("--fov")) {
-        float f = Args::to_float("--fov", *v);
-        if (!(f > 0 && f < 180)) throw UsageError("--fov must be between 0 and 180 degrees");
-        cs.camera.fov = f;
-    }
+    if (auto v = a.value("--fov")) cs.camera.fov = fov_flag(*v);
     // The flags' camera meets the script's rules (compiler/bytecode/compile.cpp).
     if (ov_has(ov, "--camera-position") || ov_has(ov, "--camera-target")) {
         std::string why = camera_problem(cs.camera);
@@ -158,10 +160,7 @@ Overrides read_overrides(Args& a) {
     (void)apply_render_flags(dry, flat);
     for (const char* f : {"--camera-position", "--camera-target"})
         if (auto v = flat.value(f)) (void)Args::to_floats(f, *v, 3);
-    if (auto v = flat.value("--fov")) {
-        const float f = Args::to_float("--fov", *v);
-        if (!(f > 0 && f < 180)) throw UsageError("--fov must be between 0 and 180 degrees");
-    }
+    if (auto v = flat.value("--fov")) (void)fov_flag(*v);
     return ov;
 }
 
@@ -284,11 +283,12 @@ int cmd_slice(Args& a) {
     if (w) so.width = Args::to_int("--width", *w, 1, 16384);
     if (h) so.height = Args::to_int("--height", *h, 1, 16384);
     if (range && !h) {  // the height follows the range's shape: within the same limit as --height
-        const double rows = double(so.width) * (double((*so.range)[3]) - (*so.range)[2]) / (double((*so.range)[1]) - (*so.range)[0]);
+        const auto& r = *so.range;
+        const double tall = (double(r[3]) - r[2]) / (double(r[1]) - r[0]), rows = so.width * tall;
         if (!(rows <= 16384.5))
             throw UsageError(fmt::format("--range is {:g} times as tall as wide: {:.4g} rows at --width {}, over 16384 (give --height: "
                                          "the picture then shows more of the plane across)",
-                                         (double((*so.range)[3]) - (*so.range)[2]) / (double((*so.range)[1]) - (*so.range)[0]), rows, so.width));
+                                         tall, rows, so.width));
     }
     if (double(so.width) * so.height > double(c.max_pixels))
         throw UsageError(fmt::format("{}x{} pixels is over the limit of {} (raise it with --max-pixels)", so.width, so.height, c.max_pixels));

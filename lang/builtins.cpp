@@ -296,14 +296,12 @@ struct Binder {
                 if (p.checks & (NonNeg | Positive)) check_size(v[k], i, p.checks & Positive);
             }
             if (slots) slots->insert(slots->end(), v.begin(), v.begin() + n);
-            if (p.checks & (Angle | Whole | Nonzero)) later.push_back({i, v, n});
+            if (p.checks & (Angle | Nonzero)) later.push_back({i, v, n});
         }
         for (const Later& l : later) {
             const ParamSpec& p = info.params[l.i];
             const NodeId x = l.v[0];
             if (p.checks & Angle) range(x, l.i, 0, 360);
-            if ((p.checks & Whole) && in.g->is_const(x) && in.g->const_value(x) != std::floor(in.g->const_value(x)))
-                in.fail(loc(l.i), fmt::format("argument '{}' of {} must be a whole number", p.name, info.name));
             if (p.checks & Nonzero) {
                 bool zero = true;
                 for (int k = 0; k < l.n; ++k) zero &= in.g->is_const(l.v[k]) && in.g->const_value(l.v[k]) == 0.0f;

@@ -55,7 +55,7 @@ enum class PT { Num, Vec3, NumOrVec3, NumOrVec2, Vec, Bool, String, Material, An
 
 // The checks of a shape's constant arguments (the Checks column of shapes.def).
 namespace param_check {
-enum : uint8_t { None = 0, Finite = 1, NonNeg = 2, Positive = 4, Angle = 8, Whole = 16, Nonzero = 32 };
+enum : uint8_t { None = 0, Finite = 1, NonNeg = 2, Positive = 4, Angle = 8, Nonzero = 32 };
 }
 
 struct ParamSpec {

@@ -224,43 +224,32 @@ Value Interp::defined_value(size_t k, const ast::Stmt& let, Env* env) {
         if (m.stmts.size() != 1 || m.stmts[0]->kind != ast::StmtKind::Expr || !m.stmts[0]->value)
             throw DefineError(fmt::format("{}: the value must be one expression", what));
         Value v = eval(*m.stmts[0]->value, env);
-        // The script's own value, for its kind: a param(...) in it is checked, not made.
+        // The script's own value, for its kind: a param(...) in it is checked, not made; but in
+        // a shader a let that is a param keeps its slider, which starts at -D's value.
+        const ast::Expr& e = *let.value;
+        const bool slider = !opts.time && e.kind == ast::ExprKind::Call && e.callee && e.callee->kind == ast::ExprKind::Ident &&
+                            e.callee->text == "param" && v.t == VT::Number && g->is_const(v.c[0]);
         const std::string outer = param_let;
         param_let = let.name;
         params_in_let = 0;
-        param_fixed = true;
+        param_fixed = !slider;
+        if (slider) param_start = g->const_value(v.c[0]);
         Value own;
         try {
-            own = eval(*let.value, env);
+            own = eval(e, env);
         } catch (...) {
             param_let = outer;
             param_fixed = false;
+            param_start.reset();
             throw;
         }
         param_let = outer;
         param_fixed = false;
+        param_start.reset();
         if (v.t != own.t || v.n != own.n)
             throw DefineError(fmt::format("{}: the script's '{}' (line {}) is {}, not {}", what, d.name, let.name_loc.line, describe(own),
                                           describe(v)));
-        // In a shader a let that is a param keeps its slider, which starts at -D's value.
-        const ast::Expr& e = *let.value;
-        const bool is_param = e.kind == ast::ExprKind::Call && e.callee && e.callee->kind == ast::ExprKind::Ident && e.callee->text == "param";
-        if (!opts.time && is_param && v.t == VT::Number && g->is_const(v.c[0])) {
-            param_let = let.name;
-            params_in_let = 0;
-            param_start = g->const_value(v.c[0]);
-            try {
-                own = eval(e, env);
-            } catch (...) {
-                param_let = outer;
-                param_start.reset();
-                throw;
-            }
-            param_let = outer;
-            param_start.reset();
-            return own;
-        }
-        return v;
+        return slider && params_in_let == 1 ? own : v;  // (a script's own def named param makes none)
     } catch (const CompileError& e) {
         const auto& diags = e.diagnostics();
         std::string msg = diags.empty() ? std::string("not a value") : diags.front().message;

@@ -89,6 +89,15 @@ TEST_CASE("params: glsl's -D sets where a param's slider starts, and the slider 
     CHECK(s.params[1].max == 3.0f);
     CHECK(s.params[1].step == 0.25f);
     CHECK(emit_glsl(s, GlslTarget::Shadertoy).find("#define SDF_PARAM_size 1.0  // in [0.2, 1.5]; line 1") != std::string::npos);
+    // A script's own def named param makes no slider: -D gives the let its value.
+    SourceManager sm2;
+    const SourceFile& own = sm2.add("own.sdf", "def param(x) = x * 2;\nlet n = param(1);\nsphere(n);\n");
+    InterpretOptions o2;
+    o2.time = std::nullopt;
+    o2.defines = {{"n", "3"}};
+    const Scene s2 = interpret_source(sm2, own, o2);
+    CHECK(s2.params.empty());
+    CHECK(test::dist(compile_scene(s2), 0, 0, 0) == Approx(-3.0f));
 }
 
 TEST_CASE("params: a name GLSL reserves (a '__' in its define) gets its index") {
