@@ -9,14 +9,17 @@
 //   tape (simplify_batch: all children of a tile in one pass) and are subdivided. Only the
 //   sign of the output matters, so min/max ops are also decided by sign (kSignOnly in
 //   runtime/eval/tape.hpp): a shape positive over a tile leaves a union there even where
-//   its interval overlaps a straddling shape's. A leaf is
-//   one 64-lane VM batch of its tape (a "trace": the parent's live instructions); the
-//   tiles above the leaves get traces too, the levels above compacted tapes.
+//   its interval overlaps a straddling shape's. The leaves of a tile run in one sweep
+//   (SweepVM, runtime/eval/vm.hpp): the tile's tape walked once, each instruction run for
+//   every leaf that needs it (simplify_masks) as that leaf's trace would run it, so no
+//   leaf tape is made, and one leaf's op does not wait for the one before it. The tiles
+//   just above the leaves get traces (the parent's live instructions), the levels above
+//   compacted tapes.
 //   The top levels run their children as oneTBB tasks while their tiles are few for the
 //   threads (Ctx::nested: one level for 2 threads), each task with scratch from a pool
-//   (not per thread: a thread waiting in a nested parallel_for may run another task). Such
-//   a level only finds which parent instructions each child needs (simplify_masks); each
-//   task then makes its own tape (simplify_lane), so the top tile's serial part is short.
+//   (not per thread: a thread waiting in a nested parallel_for may run another task). Each
+//   such task simplifies its own tape (simplify: about the result's length of work), so the
+//   top tile's serial part is its interval pass alone.
 //
 // Exactness: the interval bounds enclose the VM's float results bit for bit, and a
 // simplified tape computes, inside its tile, floats with the same sign (< 0 or not) as its
@@ -65,11 +68,13 @@ struct Scratch {
         return *p;
     }
     BatchVM ev;  // every tape of the quadtree, sized by the root's registers
+    SweepVM sweep;                                       // the leaves of a tile, all at once
+    std::vector<float> edge;                             // inputs of leaves cut by the image's edge
     uint32_t root_regs, root_choices;
     std::vector<std::unique_ptr<IntervalEvaluator>> iv;  // per depth: the choices stay readable while children run
     std::vector<Tape> tapes;                             // per depth: the tape of the tile being processed
     std::vector<BatchScratch> batch;                     // per depth: the children's tapes (or masks)
-    SimplifyScratch lane;                                // simplify_lane of a task's own tile
+    SimplifyScratch lane;                                // simplify() of a task's own tile
     uint64_t points = 0;                                 // evaluated by leaf(), since acquired
 };
 
@@ -132,6 +137,22 @@ void fill(Ctx& c, int x0, int y0, int x1, int y1, float v) {
     for (int y = y0; y < y1; ++y) std::fill(c.px + size_t(y) * c.w + x0, c.px + size_t(y) * c.w + x1, v);
 }
 
+// The pixels of a 8 x 8 leaf from the VM's results (d: row r at d + r * cols).
+void write_leaf(Ctx& c, Scratch& s, const float* d, int bx, int by) {
+    const int x1 = std::min(bx + 8, c.w), y1 = std::min(by + 8, c.h);
+    const int cols = x1 - bx, rows = y1 - by, n = cols * rows;
+    // Into a local row first: the compiler cannot tell the picture from the VM's
+    // registers, and would write pixel by pixel.
+    alignas(64) float in[kBatch];
+    for (int i = 0; i < kBatch; ++i) in[i] = d[i] < 0.0f ? 1.0f : 0.0f;
+    if (cols == 8 && rows == 8) {
+        for (int r = 0; r < 8; ++r) std::memcpy(c.px + size_t(by + r) * c.w + bx, in + r * 8, 8 * sizeof(float));
+    } else {
+        for (int r = 0; r < rows; ++r) std::copy_n(in + r * cols, cols, c.px + size_t(by + r) * c.w + bx);
+    }
+    s.points += uint64_t(n);
+}
+
 // Pixels of the tile [x0, x0 + size)^2 (clipped), 8 x 8 pixels per VM batch.
 void leaf(Ctx& c, Scratch& s, const TapeView& tape, int x0, int y0, int size) {
     alignas(64) static const float zs[kBatch] = {};  // a 2D model's z
@@ -139,7 +160,7 @@ void leaf(Ctx& c, Scratch& s, const TapeView& tape, int x0, int y0, int size) {
         for (int bx = x0; bx < std::min(x0 + size, c.w); bx += 8) {
             const int x1 = std::min(bx + 8, c.w), y1 = std::min(by + 8, c.h);
             const int cols = x1 - bx, rows = y1 - by, n = cols * rows;
-            alignas(64) float xs[kBatch], ys[kBatch], in[kBatch];  // lanes >= n are never read
+            alignas(64) float xs[kBatch], ys[kBatch];  // lanes >= n are never read
             const float* px = xs;
             const float* py = ys;
             if (cols == 8 && rows == 8) {  // the common case
@@ -155,16 +176,7 @@ void leaf(Ctx& c, Scratch& s, const TapeView& tape, int x0, int y0, int size) {
                     }
             }
             s.ev.eval(tape, px, py, zs, n, c.time);
-            const float* d = s.ev.output(tape);
-            // Into a local row first: the compiler cannot tell the picture from the VM's
-            // registers, and would write pixel by pixel.
-            for (int i = 0; i < kBatch; ++i) in[i] = d[i] < 0.0f ? 1.0f : 0.0f;
-            if (cols == 8 && rows == 8) {
-                for (int r = 0; r < 8; ++r) std::memcpy(c.px + size_t(by + r) * c.w + bx, in + r * 8, 8 * sizeof(float));
-            } else {
-                for (int r = 0; r < rows; ++r) std::copy_n(in + r * cols, cols, c.px + size_t(by + r) * c.w + bx);
-            }
-            s.points += uint64_t(n);
+            write_leaf(c, s, s.ev.output(tape), bx, by);
         }
 }
 
@@ -175,9 +187,10 @@ struct Children {
     bool leaves = false;
     int cx[kIvLanes], cy[kIvLanes], todo[kIvLanes];
     uint64_t inside = 0;
-    // The children run as tasks: each simplifies its own tape (simplify_lane) from the
-    // parent's masks, in parallel, instead of all of them before the tasks start.
+    // The children run as tasks: each simplifies its own tape, in parallel, instead of all
+    // of them before the tasks start.
     bool tasks = false;
+    bool sweep = false;  // the leaves run by SweepVM from the tile's masks (else their traces)
     const Tape* parent = nullptr;
     const IntervalEvaluator* iv = nullptr;
 };
@@ -239,8 +252,11 @@ void split(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0, Children& ch)
     ch.tasks = child >= 64 && ch.m > 1 && !ch.leaves && c.nested(depth);
     ch.parent = &t;
     ch.iv = &iv;
-    if (ch.tasks) simplify_masks(t, iv.choices(), iv.stride(), lanes, s.batch[size_t(depth)]);
-    else simplify_batch(t, iv.choices(), iv.stride(), lanes, s.batch[size_t(depth)], /*compact=*/!last_split(c, depth + 1));
+    // The leaves run in one sweep from the tile's tape and masks (no traces made); children
+    // that run as tasks each simplify their own tape.
+    ch.sweep = ch.leaves && lanes != 0 && t.linked && t.out_def != Tape::kNone;
+    if (ch.sweep) simplify_masks(t, iv.choices(), iv.stride(), lanes, s.batch[size_t(depth)]);
+    else if (!ch.tasks) simplify_batch(t, iv.choices(), iv.stride(), lanes, s.batch[size_t(depth)], /*compact=*/!last_split(c, depth + 1));
 }
 
 void process(Ctx& c, Scratch& s, int depth, Tape& t, int x0, int y0);
@@ -259,6 +275,40 @@ void descend(Ctx& c, Scratch& s, int depth, const Children& ch) {
         fill(c, ch.cx[k], ch.cy[k], std::min(ch.cx[k] + child, c.w), std::min(ch.cy[k] + child, c.h), 1.0f);
     }
     const BatchScratch& bs = s.batch[size_t(depth)];
+    if (ch.sweep) {
+        const float* xs[kIvLanes];
+        const float* ys[kIvLanes];
+        uint64_t lanes = 0;
+        for (int q = 0; q < ch.m; ++q) {
+            const int k = ch.todo[q];
+            lanes |= uint64_t(1) << k;
+            const int bx = ch.cx[k], by = ch.cy[k];
+            const int cols = std::min(bx + 8, c.w) - bx, rows = std::min(by + 8, c.h) - by;
+            if (cols == 8 && rows == 8) {
+                xs[k] = c.xb.data() + size_t(bx) * 8;
+                ys[k] = c.yb.data() + size_t(by) * 8;
+                continue;
+            }
+            // A leaf cut by the image's edge: its points in order, the rest repeating the last
+            // (as the VM pads a batch).
+            if (s.edge.size() < size_t(2 * kBatch * kIvLanes)) s.edge.resize(size_t(2 * kBatch * kIvLanes));
+            float* ex = s.edge.data() + size_t(2 * kBatch * k);
+            float* ey = ex + kBatch;
+            for (int i = 0; i < kBatch; ++i) {
+                const int p = std::min(i, cols * rows - 1);
+                ex[i] = c.xc[size_t(bx + p % cols)];
+                ey[i] = c.yc[size_t(by + p / cols)];
+            }
+            xs[k] = ex;
+            ys[k] = ey;
+        }
+        s.sweep.eval(*ch.parent, ch.iv->choices(), ch.iv->stride(), bs.mask.data(), lanes, xs, ys, nullptr, c.time);
+        for (int q = 0; q < ch.m; ++q) {
+            const int k = ch.todo[q];
+            write_leaf(c, s, s.sweep.output(k), ch.cx[k], ch.cy[k]);
+        }
+        return;
+    }
     if (ch.leaves) {
         for (int q = 0; q < ch.m; ++q) {
             const int k = ch.todo[q];
@@ -271,7 +321,7 @@ void descend(Ctx& c, Scratch& s, int depth, const Children& ch) {
             const int k = ch.todo[q];
             Scratch* s2 = c.pool->acquire();
             Tape& ct = s2->tapes[size_t(depth) + 1];
-            simplify_lane(*ch.parent, ch.iv->choices(), ch.iv->stride(), bs, k, ct, s2->lane);
+            simplify(*ch.parent, ch.iv->choices(), ch.iv->stride(), k, ct, s2->lane);
             process(c, *s2, depth + 1, ct, ch.cx[k], ch.cy[k]);
             give_back(c, s2);
         });

@@ -3,10 +3,6 @@
 // policy of compiler/bytecode/regalloc.hpp.
 #include "runtime/eval/simplify.hpp"
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include <algorithm>
 #include <iterator>
 
@@ -106,23 +102,6 @@ void simplify(const Tape& parent, const uint8_t* choices, int stride, int lane, 
 
 namespace {
 
-// Lanes (of the first 64) whose choice byte in `row` equals v.
-inline uint64_t lanes_equal(const uint8_t* row, uint8_t v) {
-#if defined(__SSE2__)
-    const __m128i want = _mm_set1_epi8(char(v));
-    uint64_t m = 0;
-    for (int q = 0; q < 4; ++q) {
-        __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + 16 * q));
-        m |= uint64_t(uint32_t(_mm_movemask_epi8(_mm_cmpeq_epi8(x, want)) & 0xFFFF)) << (16 * q);
-    }
-    return m;
-#else
-    uint64_t m = 0;
-    for (int i = 0; i < 64; ++i) m |= uint64_t(row[i] == v) << i;
-    return m;
-#endif
-}
-
 // The lanes (bits of `lanes`) in which each instruction's value is needed: mask[i]. One
 // backward pass over the parent (linked, with an output), following only the winners of
 // decided choices.
@@ -147,8 +126,8 @@ void need_masks(const Tape& parent, const uint8_t* choices, int stride, uint64_t
             continue;
         }
         const uint8_t* row = choices + size_t(l.slot) * size_t(stride);
-        const uint64_t ca = lanes_equal(row, kChoiceA), cb = lanes_equal(row, kChoiceB);
-        const uint64_t cc = in.op == Op::Select ? lanes_equal(row, kChoiceC) : 0;
+        const uint64_t ca = choice_lanes(row, kChoiceA), cb = choice_lanes(row, kChoiceB);
+        const uint64_t cc = in.op == Op::Select ? choice_lanes(row, kChoiceC) : 0;
         const uint64_t both = m & ~(ca | cb | cc);
         need[l.def[0]] |= in.op == Op::Select ? both : (m & (ca | both));
         if (in.op == Op::Min || in.op == Op::Max || in.op == Op::Select) need[l.def[1]] |= m & (cb | both);
@@ -321,39 +300,6 @@ void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint
 
 void simplify_masks(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s) {
     if (lanes != 0 && followable(parent)) need_masks(parent, choices, stride, lanes, s.mask);
-}
-
-void simplify_lane(const Tape& parent, const uint8_t* choices, int stride, const BatchScratch& masks, int lane, Tape& out,
-                   SimplifyScratch& s) {
-    out.linked = false;
-    out.links.clear();
-    out.out_def = Tape::kNone;
-    if (!followable(parent)) {
-        out.code = parent.code;
-        out.out = parent.out;
-        out.num_regs = parent.num_regs;
-        out.choices = parent.choices;
-        out.well_formed = parent.well_formed;
-        return;
-    }
-    const size_t n = parent.code.size();
-    // The lane's live instructions, in order: a branch-free scan of the masks' bit `lane`.
-    if (s.list.size() < n) s.list.resize(n);
-    uint32_t* list = s.list.data();
-    const uint64_t* need = masks.mask.data();
-    size_t count = 0;
-    for (size_t i = 0; i < n; ++i) {
-        list[count] = uint32_t(i);
-        count += (need[i] >> lane) & 1;
-    }
-    if (s.rev.size() < n + 1) s.rev.resize(n + 1);
-    Instr* end = s.rev.data() + n + 1;
-    uint32_t regs = 1;
-    const size_t nout = compact_lane(parent, choices, stride, size_t(lane), list, count, end, s.bind, s.free_regs, regs);
-    out.code.assign(end - nout, end);
-    out.out = 0;  // the output was bound first
-    out.num_regs = regs;
-    out.well_formed = true;
 }
 
 }  // namespace sdfc

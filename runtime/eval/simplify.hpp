@@ -19,7 +19,6 @@ struct SimplifyScratch {
     std::vector<uint16_t> bind;     // per parent instruction: register of its value (when live)
     std::vector<uint16_t> free_regs;
     std::vector<Instr> rev;         // emitted instructions, last first
-    std::vector<uint32_t> list;     // simplify_lane: the lane's live instructions
 };
 
 // The tape `parent` (linked) shortened for one box: the choices of `lane` (from an
@@ -64,13 +63,9 @@ struct BatchScratch {
 void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s,
                     bool compact = true);
 
-// simplify_batch(compact) in two steps, for children that run as parallel tasks: the
-// backward pass over all lanes at once (simplify_masks, into s.mask), then each lane's
-// tape on its own (simplify_lane, from any thread with its own scratch, while `parent`,
-// `choices` and `masks` stay as they are): the same tape as simplify_batch's for that lane,
-// unlinked.
+// Only simplify_batch's backward pass: s.mask[i] holds the lanes needing instruction i of
+// `parent` (nothing when `parent` cannot be followed: not linked, or no output). SweepVM
+// (runtime/eval/vm.hpp) runs the lanes from these masks without making their tapes.
 void simplify_masks(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s);
-void simplify_lane(const Tape& parent, const uint8_t* choices, int stride, const BatchScratch& masks, int lane, Tape& out,
-                   SimplifyScratch& s);
 
 }  // namespace sdfc

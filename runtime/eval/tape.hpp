@@ -4,6 +4,9 @@
 #pragma once
 #include <cstdint>
 #include <vector>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "compiler/bytecode/program.hpp"
 
@@ -16,6 +19,23 @@ enum : uint8_t {
     kChoiceB = 2,     // operand b (MinI/MaxI: the immediate k)
     kChoiceC = 3,     // operand c (Select)
 };
+// The lanes (of the first 64) whose choice byte in a slot's row equals v: the interval
+// evaluator's row is readable 64 bytes on (IntervalEvaluator::choices).
+inline uint64_t choice_lanes(const uint8_t* row, uint8_t v) {
+#if defined(__SSE2__)
+    const __m128i want = _mm_set1_epi8(char(v));
+    uint64_t m = 0;
+    for (int q = 0; q < 4; ++q) {
+        __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + 16 * q));
+        m |= uint64_t(uint32_t(_mm_movemask_epi8(_mm_cmpeq_epi8(x, want)) & 0xFFFF)) << (16 * q);
+    }
+    return m;
+#else
+    uint64_t m = 0;
+    for (int i = 0; i < 64; ++i) m |= uint64_t(row[i] == v) << i;
+    return m;
+#endif
+}
 // A bit test, not a chain of compares: link() asks it for every instruction, and the
 // branches of a chain mispredict on mixed code (measured: link() took twice as long). The
 // bits are opcodes.def's choice column.

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <cstdio>
 #include <cstring>
 #include <iterator>
 #include <new>
@@ -62,6 +63,7 @@ void BatchVM::reserve(uint32_t regs) {
 namespace isa_baseline {
 #include "runtime/eval/vmath.inl"
 #include "runtime/eval/vm_kernel.inl"
+#include "runtime/eval/sweep_kernel.inl"
 }  // namespace isa_baseline
 #undef SDFC_VMATH_LANES
 #if defined(SDFC_ISA_DISPATCH)
@@ -70,6 +72,7 @@ SDFC_ISA_BEGIN_AVX2
 namespace isa_avx2 {
 #include "runtime/eval/vmath.inl"
 #include "runtime/eval/vm_kernel.inl"
+#include "runtime/eval/sweep_kernel.inl"
 }  // namespace isa_avx2
 SDFC_ISA_END
 #undef SDFC_VMATH_LANES
@@ -78,6 +81,7 @@ SDFC_ISA_BEGIN_AVX512
 namespace isa_avx512 {
 #include "runtime/eval/vmath.inl"
 #include "runtime/eval/vm_kernel.inl"
+#include "runtime/eval/sweep_kernel.inl"
 }  // namespace isa_avx512
 SDFC_ISA_END
 #undef SDFC_VMATH_LANES
@@ -92,6 +96,15 @@ const RunFn* const kKernels[] = {
     isa_avx512::runs.data(),
 #endif
 };
+using SweepFn = void (*)(const Instr*, const Tape::Link*, size_t, const uint64_t*, uint64_t, const uint8_t*, int, float* const*,
+                        const float* const*, const float* const*, const float* const*, float);
+const SweepFn kSweeps[] = {
+    isa_baseline::sweep,
+#if defined(SDFC_ISA_DISPATCH)
+    isa_avx2::sweep,
+    isa_avx512::sweep,
+#endif
+};
 const RunFn* kernels() {
     const int i = static_cast<int>(current_isa());
     return kKernels[i < int(std::size(kKernels)) ? i : 0];
@@ -104,6 +117,22 @@ void BatchVM::eval(const TapeView& t, const float* x, const float* y, const floa
     const int m = (n + kGroup - 1) / kGroup * kGroup;  // lanes computed
     const Instr* end = t.code + t.len;
     kernels()[m / kGroup - 1](t.code, end, t.guards, regs_, x, y, z, n, time);
+}
+
+void SweepVM::eval(const Tape& t, const uint8_t* choices, int stride, const uint64_t* need, uint64_t lanes,
+                   const float* const* x, const float* const* y, const float* const* z, float time) {
+    const size_t per = size_t(std::max<uint32_t>(t.num_regs, uint32_t(t.out) + 1)) * kBatch;
+    const size_t want = per * size_t(__builtin_popcountll(lanes));
+    if (want > size_) {
+        storage_ = {alloc_regs(want), &free_aligned};
+        size_ = want;
+    }
+    size_t q = 0;
+    for (uint64_t r = lanes; r; r &= r - 1) base_[__builtin_ctzll(r)] = storage_.get() + per * q++;
+    out_ = t.out;
+    const int i = static_cast<int>(current_isa());
+    kSweeps[i < int(std::size(kSweeps)) ? i : 0](t.code.data(), t.links.data(), t.code.size(), need, lanes, choices, stride,
+                                                 base_, x, y, z, time);
 }
 
 void sample_batch(const Program& p, const float* x, const float* y, const float* z, size_t n, float time, float* out) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "compiler/bytecode/program.hpp"
+#include "runtime/eval/tape.hpp"
 
 namespace sdfc {
 
@@ -34,6 +35,28 @@ private:
     uint32_t max_regs_ = 0;
     std::unique_ptr<float[], void (*)(float*)> storage_;
     float* regs_ = nullptr;
+};
+
+// Many lanes of an interval pass evaluated at once, each lane a batch of kBatch points of
+// its own box (raster2d's leaves: the 8 x 8 pixels of each child of a tile): one walk over
+// the parent tape `t` (linked), each instruction run for the lanes whose need mask (`need`,
+// from simplify_masks) holds it, with each lane's decided choices. Bit for bit what
+// simplify_batch(compact = false) and a BatchVM::eval of each lane's trace give, without
+// writing the traces; and one lane's op does not wait for another's result, as a trace's
+// next op waits for the one before (the VM's registers are memory).
+class SweepVM {
+public:
+    // Lane j (each bit of `lanes`) reads x[j], y[j] and z[j], kBatch points each (z null:
+    // every z is 0).
+    void eval(const Tape& t, const uint8_t* choices, int stride, const uint64_t* need, uint64_t lanes,
+              const float* const* x, const float* const* y, const float* const* z, float time);
+    const float* output(int lane) const { return base_[lane] + size_t(out_) * kBatch; }
+
+private:
+    std::unique_ptr<float[], void (*)(float*)> storage_{nullptr, nullptr};
+    size_t size_ = 0;  // floats
+    float* base_[64] = {};
+    uint16_t out_ = 0;
 };
 
 // sample_scalar's values through the batch VM (a FieldSampler, see program.hpp).

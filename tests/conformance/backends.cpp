@@ -32,6 +32,47 @@ std::vector<float> BatchVm::eval(const Program& p, const std::vector<Point>& pts
 
 // --- simplified tapes ---
 
+namespace {
+
+// Boxes at .. at + n of an IntervalEvaluator pass over `full`: their points through SweepVM,
+// kBatch points of every box a sweep (a box with fewer repeats its last, as the VM pads).
+void sweep_boxes(const Tape& full, const IntervalEvaluator& iv, int n, const std::vector<std::vector<Point>>& pts, size_t at,
+                 float time, BatchScratch& batch, std::vector<std::vector<float>>& out) {
+    const uint64_t all = n == 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1;
+    simplify_masks(full, iv.choices(), iv.stride(), all, batch);
+    if (!full.linked || full.out_def == Tape::kNone) throw std::runtime_error("a tape the sweep cannot follow");
+    SweepVM sweep;
+    std::vector<float> in(size_t(n) * 3 * kBatch);
+    const float* xs[kIvLanes];
+    const float* ys[kIvLanes];
+    const float* zs[kIvLanes];
+    for (size_t i = 0;; i += kBatch) {
+        uint64_t lanes = 0;
+        for (int l = 0; l < n; ++l) {
+            const std::vector<Point>& q = pts[at + size_t(l)];
+            if (i >= q.size()) continue;
+            lanes |= uint64_t(1) << l;
+            float* x = in.data() + size_t(l) * 3 * kBatch;
+            for (int j = 0; j < kBatch; ++j) {
+                const Point& pt = q[std::min(i + size_t(j), q.size() - 1)];
+                x[j] = pt.x, x[kBatch + j] = pt.y, x[2 * kBatch + j] = pt.z;
+            }
+            xs[l] = x;
+            ys[l] = x + kBatch;
+            zs[l] = x + 2 * kBatch;
+        }
+        if (!lanes) return;
+        sweep.eval(full, iv.choices(), iv.stride(), batch.mask.data(), lanes, xs, ys, zs, time);
+        for (uint64_t r = lanes; r; r &= r - 1) {
+            const int l = __builtin_ctzll(r);
+            const size_t m = std::min<size_t>(kBatch, pts[at + size_t(l)].size() - i);
+            out[at + size_t(l)].insert(out[at + size_t(l)].end(), sweep.output(l), sweep.output(l) + m);
+        }
+    }
+}
+
+}  // namespace
+
 template <Simplifier S>
 std::vector<std::vector<float>> SimplifiedTape<S>::eval_in_boxes(const Program& p, const std::vector<Box>& boxes,
                                                                  const std::vector<std::vector<Point>>& pts, float time) {
@@ -54,6 +95,10 @@ std::vector<std::vector<float>> SimplifiedTape<S>::eval_in_boxes(const Program& 
         }
         iv.eval(full, lo[0], hi[0], lo[1], hi[1], lo[2], hi[2], n, time);
         iv.prune_min_chains(full, n);  // (only with keep_chains)
+        if (S == Simplifier::Sweep) {
+            sweep_boxes(full, iv, n, pts, at, time, batch, out);
+            continue;
+        }
         if (S != Simplifier::One)
             simplify_batch(full, iv.choices(), iv.stride(), n == 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1, batch,
                            S != Simplifier::BatchTrace);
@@ -110,6 +155,7 @@ template struct SimplifiedTape<Simplifier::BatchCompact>;
 template struct SimplifiedTape<Simplifier::BatchTrace>;
 template struct SimplifiedTape<Simplifier::SignOnly>;
 template struct SimplifiedTape<Simplifier::MinChain>;
+template struct SimplifiedTape<Simplifier::Sweep>;
 
 // --- intervals ---
 

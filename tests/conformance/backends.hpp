@@ -46,7 +46,9 @@ struct BatchVm {
 // as the 2D renderer does): not the same floats, only the same "< 0" at every point.
 // MinChain: simplify_batch(compact) after prune_min_chains (Tape::mark_min_chains, as the
 // tape tree does): the same floats.
-enum class Simplifier { One, BatchCompact, BatchTrace, SignOnly, MinChain };
+// Sweep: no tapes made: simplify_masks, then SweepVM runs the full tape for every box at
+// once (as the 2D renderer's leaves do): the traces' floats, so the same floats.
+enum class Simplifier { One, BatchCompact, BatchTrace, SignOnly, MinChain, Sweep };
 template <Simplifier S>
 struct SimplifiedTape {
     static constexpr bool kVmFloats = true;
@@ -62,6 +64,7 @@ using SimplifyBatchCompact = SimplifiedTape<Simplifier::BatchCompact>;
 using SimplifyBatchTrace = SimplifiedTape<Simplifier::BatchTrace>;
 using SimplifySignOnly = SimplifiedTape<Simplifier::SignOnly>;
 using SimplifyMinChain = SimplifiedTape<Simplifier::MinChain>;
+using SimplifySweep = SimplifiedTape<Simplifier::Sweep>;
 
 // The GLSL emitter (compiler/glsl/glsl_emit.hpp) on Mesa llvmpipe: each case is a fragment
 // shader that reads the points from a float texture and writes the value's bits as RGBA8.

@@ -163,7 +163,7 @@ TEMPLATE_TEST_CASE("every shape, operation and example: the interval encloses th
 }
 
 TEMPLATE_TEST_CASE("every case: a tape simplified for a box computes the full program's floats in it", "[simplify]",
-                   SimplifyOne, SimplifyBatchCompact, SimplifyBatchTrace, SimplifySignOnly, SimplifyMinChain) {
+                   SimplifyOne, SimplifyBatchCompact, SimplifyBatchTrace, SimplifySignOnly, SimplifyMinChain, SimplifySweep) {
     auto check = [](const Case& c, const Program& p, const std::vector<Box>& boxes, const std::vector<std::vector<Point>>& pts) {
         const auto got = TestType{}.eval_in_boxes(p, boxes, pts, c.time);
         for (size_t b = 0; b < boxes.size(); ++b) {

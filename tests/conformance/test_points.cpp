@@ -73,7 +73,7 @@ void check_points(const std::vector<Case>& cases) {
 
 }  // namespace
 
-#define POINT_BACKENDS Scalar, BatchVm, SimplifyOne, SimplifyBatchCompact, SimplifyBatchTrace, GlslLlvmpipe, GlslTapeLlvmpipe
+#define POINT_BACKENDS Scalar, BatchVm, SimplifyOne, SimplifyBatchCompact, SimplifyBatchTrace, SimplifySweep, GlslLlvmpipe, GlslTapeLlvmpipe
 
 TEMPLATE_TEST_CASE("every opcode gives its opcodes.def semantics", "[opcodes]", POINT_BACKENDS) {
     check_points<TestType>(opcode_cases());

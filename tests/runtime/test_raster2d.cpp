@@ -3,8 +3,11 @@
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <random>
 #include <thread>
 #include <vector>
+
+#include <fmt/format.h>
 
 #include "compiler/bytecode/compile.hpp"
 #include "lang/load.hpp"
@@ -58,6 +61,58 @@ TEST_CASE("render_2d: hi.vm and quarter.vm equal brute force, odd sizes too") {
     check_identical("hi.vm", 301, 173);
     check_identical("quarter.vm", 77, 1000);
     check_identical("prospero.vm", 517, 263);
+}
+
+// A Prospero-like model made here (no shared files): a union of discs, each cut by a half
+// plane, minus a few rings, with a wavy edge (sin, exp) on one disc. Its leaves run through
+// the sweep, with choices decided per leaf and copies of winners.
+std::string generated_model(int discs) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f), r(0.02f, 0.25f);
+    std::string m = "x var-x\ny var-y\n";
+    std::string acc;
+    for (int i = 0; i < discs; ++i) {
+        m += fmt::format("cx{0} const {1}\ncy{0} const {2}\nr{0} const {3}\nk{0} const {4}\n", i, u(rng), u(rng), r(rng), u(rng));
+        m += fmt::format("dx{0} sub x cx{0}\ndy{0} sub y cy{0}\nsx{0} square dx{0}\nsy{0} square dy{0}\n", i);
+        m += fmt::format("s{0} add sx{0} sy{0}\nl{0} sqrt s{0}\nd{0} sub l{0} r{0}\n", i);
+        m += fmt::format("h{0} sub dy{0} k{0}\nc{0} max d{0} h{0}\n", i);  // cut by the half plane y > cy + k
+        if (i % 17 == 3) m += fmt::format("w{0} sin dx{0}\ne{0} exp w{0}\nq{0} mul e{0} r{0}\nc{0}b min c{0} q{0}\n", i);
+        const std::string c = i % 17 == 3 ? fmt::format("c{}b", i) : fmt::format("c{}", i);
+        if (acc.empty()) {
+            acc = c;
+        } else {
+            m += fmt::format("u{0} min {1} {2}\n", i, acc, c);
+            acc = fmt::format("u{}", i);
+        }
+        if (i % 9 == 8) {  // a ring taken out: max(acc, -(|d| - 0.01))
+            m += fmt::format("a{0} abs d{0}\nt{0} const 0.01\nb{0} sub a{0} t{0}\nn{0} neg b{0}\nv{0} max {1} n{0}\n", i, acc);
+            acc = fmt::format("v{}", i);
+        }
+    }
+    return m;
+}
+
+TEST_CASE("render_2d: a generated model of 300 cut discs equals brute force, at several sizes and thread counts") {
+    SourceManager sm;
+    const SourceFile& f = sm.add("generated.vm", generated_model(300));
+    CompiledScene cs = compile_scene(load_vm(sm, f));
+    REQUIRE(cs.is_2d);
+    for (auto [w, h, threads] : {std::tuple{1024, 1024, 2}, {1024, 1024, 1}, {301, 173, 2}, {77, 1000, 8}, {8, 8, 1}, {9, 700, 2}}) {
+        RenderStats fast_stats, brute_stats;
+        const Image fast = render_2d(cs, w, h, threads, false, &fast_stats);
+        const Image brute = render_2d(cs, w, h, 0, true, &brute_stats);
+        REQUIRE(fast.pixels.size() == brute.pixels.size());
+        size_t differ = 0, white = 0;
+        for (size_t i = 0; i < fast.pixels.size(); ++i) {
+            differ += fast.pixels[i] != brute.pixels[i];
+            white += brute.pixels[i] > 0.5f;
+        }
+        INFO(w << "x" << h << ", threads " << threads << ": " << differ << " pixels differ, " << white << " white");
+        CHECK(differ == 0);
+        CHECK(white > 0);
+        CHECK(white < fast.pixels.size());
+        if (w * h > 10000) CHECK(fast_stats.distance_points < brute_stats.distance_points);
+    }
 }
 
 TEST_CASE("Raster2d: a prepared model draws the same image every time, from several threads at once") {
