@@ -7,6 +7,16 @@
 // winner (nothing when it is already in place) or, for an immediate, a constant. Every op
 // computes exactly as the VM's handler for it does. A Guard never skips: skipping changes no
 // float (vm_kernel.inl), so running its region through gives the same values.
+// The lanes whose choice byte in a slot's row equals v: one compare of the row where the
+// copy has AVX-512BW (SDFC_SWEEP_BW, set by vm.cpp), else tape.hpp's.
+inline uint64_t sweep_lanes(const uint8_t* row, uint8_t v) {
+#if SDFC_SWEEP_BW
+    return _mm512_cmpeq_epi8_mask(_mm512_loadu_si512(row), _mm512_set1_epi8(char(v)));
+#else
+    return choice_lanes(row, v);
+#endif
+}
+
 void sweep(const Instr* code, const Tape::Link* links, size_t n, const uint64_t* need, uint64_t group, const uint8_t* choices, int stride,
            float* const* base, const float* const* xs, const float* const* ys, const float* const* zs, float time) {
     alignas(64) static const float zeros[kBatch] = {};
@@ -22,8 +32,8 @@ void sweep(const Instr* code, const Tape::Link* links, size_t n, const uint64_t*
         uint64_t run = m;
         if (const uint32_t sl = links[at].slot; sl != Tape::kNone) {
             const uint8_t* row = choices + size_t(sl) * size_t(stride);
-            const uint64_t ca = m & choice_lanes(row, kChoiceA), cb = m & choice_lanes(row, kChoiceB);
-            const uint64_t cc = ip->op == Op::Select ? m & choice_lanes(row, kChoiceC) : 0;
+            const uint64_t ca = m & sweep_lanes(row, kChoiceA), cb = m & sweep_lanes(row, kChoiceB);
+            const uint64_t cc = ip->op == Op::Select ? m & sweep_lanes(row, kChoiceC) : 0;
             run = m & ~(ca | cb | cc);
             if (ip->a != ip->out)
                 for (uint64_t r = ca; r; r &= r - 1) copy(base[__builtin_ctzll(r)] + out, base[__builtin_ctzll(r)] + size_t(ip->a) * kBatch);

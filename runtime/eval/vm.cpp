@@ -60,11 +60,18 @@ void BatchVM::reserve(uint32_t regs) {
 #else
 #define SDFC_VMATH_LANES 1
 #endif
+#if defined(__AVX512BW__)
+#define SDFC_SWEEP_BW 1
+#else
+#define SDFC_SWEEP_BW 0
+#endif
 namespace isa_baseline {
 #include "runtime/eval/vmath.inl"
 #include "runtime/eval/vm_kernel.inl"
 #include "runtime/eval/sweep_kernel.inl"
 }  // namespace isa_baseline
+#undef SDFC_SWEEP_BW
+#define SDFC_SWEEP_BW 0
 #undef SDFC_VMATH_LANES
 #if defined(SDFC_ISA_DISPATCH)
 #define SDFC_VMATH_LANES 8
@@ -78,6 +85,8 @@ SDFC_ISA_END
 #undef SDFC_VMATH_LANES
 #define SDFC_VMATH_LANES 16
 SDFC_ISA_BEGIN_AVX512
+#undef SDFC_SWEEP_BW
+#define SDFC_SWEEP_BW 1
 namespace isa_avx512 {
 #include "runtime/eval/vmath.inl"
 #include "runtime/eval/vm_kernel.inl"
@@ -86,6 +95,7 @@ namespace isa_avx512 {
 SDFC_ISA_END
 #undef SDFC_VMATH_LANES
 #endif
+#undef SDFC_SWEEP_BW
 
 namespace {
 // Each instruction set's kernels, by lane count (vm_kernel.inl).

@@ -40,7 +40,8 @@ std::vector<std::string> examples() {
     return out;
 }
 
-// Every bit of the VM's distances and the intervals' bounds and choices at fixed points and boxes.
+// Every bit of the VM's distances, the intervals' bounds and choices, and the sweep's values
+// (SweepVM: each box's 64 points through its simplified tape) at fixed points and boxes.
 std::vector<uint32_t> fingerprint(const Program& p) {
     std::vector<uint32_t> bits;
     auto put = [&](float v) {
@@ -53,6 +54,8 @@ std::vector<uint32_t> fingerprint(const Program& p) {
     BatchVM vm(p.num_regs);
     const Tape tape = Tape::from(p);
     IntervalEvaluator iv(tape.num_regs, tape.choices);
+    BatchScratch masks;
+    SweepVM sweep;
     for (int round = 0; round < 8; ++round) {
         const int n = round == 7 ? kBatch : 8 * round + 5;  // every kernel (one per lane count: 8, 16, ... 64)
         float x[kBatch], y[kBatch], z[kBatch], xh[kBatch], yh[kBatch], zh[kBatch];
@@ -66,6 +69,26 @@ std::vector<uint32_t> fingerprint(const Program& p) {
         for (int i = 0; i < n; ++i) put(iv.result(i).lo), put(iv.result(i).hi);
         for (uint32_t s = 0; s < tape.choices; ++s)
             for (int i = 0; i < n; ++i) bits.push_back(iv.choices()[s * iv.stride() + i]);
+        const uint64_t lanes = n == 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1;
+        simplify_masks(tape, iv.choices(), iv.stride(), lanes, masks);
+        if (!tape.linked || tape.out_def == Tape::kNone) continue;
+        std::vector<float> in(size_t(n) * 3 * kBatch);
+        const float* px[kIvLanes];
+        const float* py[kIvLanes];
+        const float* pz[kIvLanes];
+        for (int l = 0; l < n; ++l) {
+            float* q = in.data() + size_t(l) * 3 * kBatch;
+            for (int i = 0; i < kBatch; ++i) {
+                const float f = float(i) / float(kBatch - 1);
+                q[i] = x[l] + (xh[l] - x[l]) * f;
+                q[kBatch + i] = y[l] + (yh[l] - y[l]) * (1.0f - f);
+                q[2 * kBatch + i] = z[l] + (zh[l] - z[l]) * f * f;
+            }
+            px[l] = q, py[l] = q + kBatch, pz[l] = q + 2 * kBatch;
+        }
+        sweep.eval(tape, iv.choices(), iv.stride(), masks.mask.data(), lanes, px, py, pz, 0.5f);
+        for (int l = 0; l < n; ++l)
+            for (int i = 0; i < kBatch; ++i) put(sweep.output(l)[i]);
     }
     return bits;
 }
