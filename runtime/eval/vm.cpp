@@ -132,17 +132,33 @@ void BatchVM::eval(const TapeView& t, const float* x, const float* y, const floa
 void SweepVM::eval(const Tape& t, const uint8_t* choices, int stride, const uint64_t* need, uint64_t lanes,
                    const float* const* x, const float* const* y, const float* const* z, float time) {
     const size_t per = size_t(std::max<uint32_t>(t.num_regs, uint32_t(t.out) + 1)) * kBatch;
-    const size_t want = per * size_t(__builtin_popcountll(lanes));
-    if (want > size_) {
-        storage_ = {alloc_regs(want), &free_aligned};
-        size_ = want;
+    const size_t count = size_t(__builtin_popcountll(lanes));
+    // As many lanes a pass as max_floats_ holds (at least one): all of them but for tapes
+    // of thousands of registers, whose passes then copy their outputs aside.
+    const size_t group = std::clamp<size_t>(max_floats_ / per, 1, std::max<size_t>(count, 1));
+    if (per * group > size_) {
+        storage_ = {alloc_regs(per * group), &free_aligned};
+        size_ = per * group;
     }
-    size_t q = 0;
-    for (uint64_t r = lanes; r; r &= r - 1) base_[__builtin_ctzll(r)] = storage_.get() + per * q++;
-    out_ = t.out;
-    const int i = static_cast<int>(current_isa());
-    kSweeps[i < int(std::size(kSweeps)) ? i : 0](t.code.data(), t.links.data(), t.code.size(), need, lanes, choices, stride,
-                                                 base_, x, y, z, time);
+    if (group < count && !outs_) outs_ = std::make_unique<float[]>(size_t(64) * kBatch);
+    const int isa = static_cast<int>(current_isa());
+    const auto kernel = kSweeps[isa < int(std::size(kSweeps)) ? isa : 0];
+    while (lanes) {
+        uint64_t pass = 0;
+        size_t q = 0;
+        for (uint64_t r = lanes; r && q < group; r &= r - 1) {
+            const int j = __builtin_ctzll(r);
+            pass |= uint64_t(1) << j;
+            base_[j] = storage_.get() + per * q++;
+        }
+        lanes &= ~pass;
+        kernel(t.code.data(), t.links.data(), t.code.size(), need, pass, choices, stride, base_, x, y, z, time);
+        for (uint64_t r = pass; r; r &= r - 1) {
+            const int j = __builtin_ctzll(r);
+            out_[j] = base_[j] + size_t(t.out) * kBatch;
+            if (group < count) out_[j] = std::copy_n(out_[j], kBatch, outs_.get() + size_t(j) * kBatch) - kBatch;
+        }
+    }
 }
 
 void sample_batch(const Program& p, const float* x, const float* y, const float* z, size_t n, float time, float* out) {

@@ -43,20 +43,25 @@ private:
 // from simplify_masks) holds it, with each lane's decided choices. Bit for bit what
 // simplify_batch(compact = false) and a BatchVM::eval of each lane's trace give, without
 // writing the traces; and one lane's op does not wait for another's result, as a trace's
-// next op waits for the one before (the VM's registers are memory).
+// next op waits for the one before (the VM's registers are memory). The lanes' register
+// files take at most max_floats floats (4 MB by default): a tape with thousands of
+// registers runs its lanes in several passes.
 class SweepVM {
 public:
+    explicit SweepVM(size_t max_floats = size_t(1) << 20) : max_floats_(max_floats) {}
     // Lane j (each bit of `lanes`) reads x[j], y[j] and z[j], kBatch points each (z null:
     // every z is 0).
     void eval(const Tape& t, const uint8_t* choices, int stride, const uint64_t* need, uint64_t lanes,
               const float* const* x, const float* const* y, const float* const* z, float time);
-    const float* output(int lane) const { return base_[lane] + size_t(out_) * kBatch; }
+    const float* output(int lane) const { return out_[lane]; }
 
 private:
+    size_t max_floats_;
     std::unique_ptr<float[], void (*)(float*)> storage_{nullptr, nullptr};
-    size_t size_ = 0;  // floats
+    std::unique_ptr<float[]> outs_;  // the lanes' outputs, when not all lanes fit one pass
+    size_t size_ = 0;                // floats
     float* base_[64] = {};
-    uint16_t out_ = 0;
+    const float* out_[64] = {};
 };
 
 // sample_scalar's values through the batch VM (a FieldSampler, see program.hpp).

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <stdexcept>
 
@@ -41,7 +42,7 @@ void sweep_boxes(const Tape& full, const IntervalEvaluator& iv, int n, const std
     const uint64_t all = n == 64 ? ~uint64_t(0) : (uint64_t(1) << n) - 1;
     simplify_masks(full, iv.choices(), iv.stride(), all, batch);
     if (!full.linked || full.out_def == Tape::kNone) throw std::runtime_error("a tape the sweep cannot follow");
-    SweepVM sweep;
+    SweepVM sweep, one_a_pass(1);  // (the second runs its lanes in passes of one)
     std::vector<float> in(size_t(n) * 3 * kBatch);
     const float* xs[kIvLanes];
     const float* ys[kIvLanes];
@@ -63,8 +64,11 @@ void sweep_boxes(const Tape& full, const IntervalEvaluator& iv, int n, const std
         }
         if (!lanes) return;
         sweep.eval(full, iv.choices(), iv.stride(), batch.mask.data(), lanes, xs, ys, zs, time);
+        one_a_pass.eval(full, iv.choices(), iv.stride(), batch.mask.data(), lanes, xs, ys, zs, time);
         for (uint64_t r = lanes; r; r &= r - 1) {
             const int l = __builtin_ctzll(r);
+            if (std::memcmp(sweep.output(l), one_a_pass.output(l), sizeof(float) * kBatch) != 0)
+                throw std::runtime_error("the sweep's lanes run one a pass give other floats");
             const size_t m = std::min<size_t>(kBatch, pts[at + size_t(l)].size() - i);
             out[at + size_t(l)].insert(out[at + size_t(l)].end(), sweep.output(l), sweep.output(l) + m);
         }
