@@ -449,13 +449,16 @@ SDFC_IV_INLINE int sign_choice(int c, float al, float ah, float bl, float bh, fl
         const bool pick_b = O == Op::Min ? (neg_b | pos_a) : (pos_b | neg_a);
         const int s = pick_a ? int(kChoiceA) : (pick_b ? int(kChoiceB) : int(kChoiceBoth));
         return c != kChoiceBoth ? c : (known ? s : c);
-    } else if constexpr (O == Op::MinI) {
-        // k >= 0: min(a, k) < 0 is a < 0 (also for NaN a); k < 0: always true (not for NaN a).
+    } else if constexpr (O == Op::MinI || O == Op::MaxI) {
+        // A winner must also be NaN where the op is (a sign-only user's min_/max_ takes a NaN
+        // operand as it takes no number: max_(x, NaN) is x, max_(x, 0) is 0). min_(a, k) and
+        // max_(a, k) are NaN exactly where a is, so a wins whenever it has the op's sign:
+        //   min: k >= 0 -> a;  max: k < 0 -> a.
+        // The immediate only where a is never NaN (known): min: k < 0 -> k;  max: k >= 0 -> k.
         const bool known = (al == al) & (ah == ah);
-        return c != kChoiceBoth ? c : (k >= 0.0f ? int(kChoiceA) : ((k < 0.0f) & known ? int(kChoiceB) : c));
-    } else if constexpr (O == Op::MaxI) {
-        // k < 0: max(a, k) < 0 is a < 0; k >= 0: never (both also for NaN a).
-        return c != kChoiceBoth ? c : (k < 0.0f ? int(kChoiceA) : (k >= 0.0f ? int(kChoiceB) : c));
+        const bool to_a = O == Op::MinI ? k >= 0.0f : k < 0.0f;
+        const bool to_k = O == Op::MinI ? k < 0.0f : k >= 0.0f;
+        return c != kChoiceBoth ? c : (to_a ? int(kChoiceA) : (to_k & known ? int(kChoiceB) : c));
     } else {
         return c;
     }

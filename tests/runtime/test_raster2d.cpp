@@ -115,6 +115,22 @@ TEST_CASE("render_2d: a generated model of 300 cut discs equals brute force, at 
     }
 }
 
+// max(ln x, 0) is NaN where x < 0, and max(x, NaN) is x there: inside. A sign-only
+// decision once replaced max(ln x, 0) by its 0 where ln x may be NaN ("never < 0" for the op
+// itself), and max(x, 0) is not inside: the left half came out empty.
+TEST_CASE("render_2d: a sign decision keeps a NaN operand's NaN (max(x, max(ln x, 0)))") {
+    SourceManager sm;
+    const SourceFile& f = sm.add("nan.vm", "x var-x\nz const 0\nl ln x\nm max l z\no max x m\n");
+    const CompiledScene cs = compile_scene(load_vm(sm, f));
+    for (auto [w, h] : {std::pair{16, 1}, {64, 64}, {9, 700}}) {
+        const Image fast = render_2d(cs, w, h, 1), brute = render_2d(cs, w, h, 1, true);
+        INFO(w << "x" << h);
+        CHECK(fast.pixels == brute.pixels);
+        CHECK(fast.at(0, h - 1, 0) == 1.0f);  // x = -1: inside
+        CHECK(fast.at(w - 1, 0, 0) == 0.0f);  // x = 1: outside
+    }
+}
+
 TEST_CASE("Raster2d: a prepared model draws the same image every time, from several threads at once") {
     const fs::path path = fs::path(SDFC_SHARED_DIR) / "bench" / "vm" / "prospero.vm";
     if (!fs::exists(path)) {
