@@ -428,7 +428,6 @@ Image Raster2d::render(int w, int h, int threads, RenderStats* stats) const {
     Ctx c{w, h, nullptr, p_->scene.time, &pool};
     c.threads = threads > 0 ? threads : tbb::this_task_arena::max_concurrency();
     pixel_grid(w, h, c.xc, c.yc);
-    block_inputs(c);
 
     int size = kLeaf;
     while (size < w || size < h) size *= 2;
@@ -438,16 +437,21 @@ Image Raster2d::render(int w, int h, int threads, RenderStats* stats) const {
     // (instruction counts under callgrind): the cheapest for prospero.vm.
     while (c.sizes.back() >= 128) c.sizes.push_back(c.sizes.back() / 4);
     if (c.sizes.back() > kLeaf) c.sizes.push_back(kLeaf);
-    // The image's allocation (zeroing 4 bytes a pixel) overlaps the top level's work.
+    // The image's allocation (zeroing 4 bytes a pixel) and the leaves' input rows overlap the
+    // top level's work.
     Image img;
     Scratch* s = nullptr;
     Children top;
     Tape& root = p_->root;  // (split() only reads a linked tape)
-    tbb::parallel_invoke([&] { img = Image(w, h, 1); },
-                         [&] {
-                             s = pool.acquire();
-                             if (c.sizes.size() > 1) split(c, *s, 0, root, 0, 0, top);
-                         });
+    tbb::parallel_invoke(
+        [&] {
+            img = Image(w, h, 1);
+            block_inputs(c);
+        },
+        [&] {
+            s = pool.acquire();
+            if (c.sizes.size() > 1) split(c, *s, 0, root, 0, 0, top);
+        });
     c.px = img.pixels.data();
     if (c.sizes.size() > 1) descend(c, *s, 0, top);
     else process(c, *s, 0, root, 0, 0);
