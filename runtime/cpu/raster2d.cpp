@@ -75,7 +75,7 @@ struct Scratch {
     std::vector<Tape> tapes;                             // per depth: the tape of the tile being processed
     std::vector<BatchScratch> batch;                     // per depth: the children's tapes (or masks)
     SimplifyScratch lane;                                // simplify() of a task's own tile
-    uint64_t points = 0;                                 // evaluated by leaf(), since acquired
+    uint64_t points = 0;                                 // evaluated at the leaves, since acquired
 };
 
 // Scratch objects handed to tasks (not threads: a thread waiting in a nested parallel_for
