@@ -153,28 +153,34 @@ void write_leaf(Ctx& c, Scratch& s, const float* d, int bx, int by) {
     s.points += uint64_t(n);
 }
 
+// The x and y inputs of the 8 x 8 leaf at (bx, by): a full one's rows of the tables made
+// once a render (block_inputs), else its points in order written to xs and ys (kBatch
+// each), the lanes past them repeating the last (as the VM pads a batch).
+void leaf_inputs(const Ctx& c, int bx, int by, float* xs, float* ys, const float*& px, const float*& py) {
+    const int cols = std::min(bx + 8, c.w) - bx, rows = std::min(by + 8, c.h) - by;
+    if (cols == 8 && rows == 8) {  // the common case
+        px = c.xb.data() + size_t(bx) * 8;
+        py = c.yb.data() + size_t(by) * 8;
+        return;
+    }
+    for (int i = 0; i < kBatch; ++i) {
+        const int p = std::min(i, cols * rows - 1);
+        xs[i] = c.xc[size_t(bx + p % cols)];
+        ys[i] = c.yc[size_t(by + p / cols)];
+    }
+    px = xs;
+    py = ys;
+}
+
 // Pixels of the tile [x0, x0 + size)^2 (clipped), 8 x 8 pixels per VM batch.
 void leaf(Ctx& c, Scratch& s, const TapeView& tape, int x0, int y0, int size) {
     alignas(64) static const float zs[kBatch] = {};  // a 2D model's z
     for (int by = y0; by < std::min(y0 + size, c.h); by += 8)
         for (int bx = x0; bx < std::min(x0 + size, c.w); bx += 8) {
-            const int x1 = std::min(bx + 8, c.w), y1 = std::min(by + 8, c.h);
-            const int cols = x1 - bx, rows = y1 - by, n = cols * rows;
-            alignas(64) float xs[kBatch], ys[kBatch];  // lanes >= n are never read
-            const float* px = xs;
-            const float* py = ys;
-            if (cols == 8 && rows == 8) {  // the common case
-                px = c.xb.data() + size_t(bx) * 8;
-                py = c.yb.data() + size_t(by) * 8;
-            } else {
-                const float* xc = c.xc.data() + bx;
-                const float* yc = c.yc.data() + by;
-                for (int r = 0; r < rows; ++r)
-                    for (int q = 0; q < cols; ++q) {
-                        xs[r * cols + q] = xc[q];
-                        ys[r * cols + q] = yc[r];
-                    }
-            }
+            const int n = (std::min(bx + 8, c.w) - bx) * (std::min(by + 8, c.h) - by);
+            alignas(64) float xs[kBatch], ys[kBatch];
+            const float *px, *py;
+            leaf_inputs(c, bx, by, xs, ys, px, py);
             s.ev.eval(tape, px, py, zs, n, c.time);
             write_leaf(c, s, s.ev.output(tape), bx, by);
         }
@@ -284,27 +290,12 @@ void descend(Ctx& c, Scratch& s, int depth, const Children& ch) {
             const int k = ch.todo[q];
             lanes |= uint64_t(1) << k;
             const int bx = ch.cx[k], by = ch.cy[k];
-            const int cols = std::min(bx + 8, c.w) - bx, rows = std::min(by + 8, c.h) - by;
             // The leaf's rows of the picture, fetched while the sweep runs: written after it,
             // they missed the cache (prospero.vm 0.94x-0.96x the time).
-            for (int r = 0; r < rows; ++r) __builtin_prefetch(c.px + size_t(by + r) * c.w + bx, 1, 3);
-            if (cols == 8 && rows == 8) {
-                xs[k] = c.xb.data() + size_t(bx) * 8;
-                ys[k] = c.yb.data() + size_t(by) * 8;
-                continue;
-            }
-            // A leaf cut by the image's edge: its points in order, the rest repeating the last
-            // (as the VM pads a batch).
+            for (int r = 0; r < std::min(by + 8, c.h) - by; ++r) __builtin_prefetch(c.px + size_t(by + r) * c.w + bx, 1, 3);
             if (s.edge.size() < size_t(2 * kBatch * kIvLanes)) s.edge.resize(size_t(2 * kBatch * kIvLanes));
-            float* ex = s.edge.data() + size_t(2 * kBatch * k);
-            float* ey = ex + kBatch;
-            for (int i = 0; i < kBatch; ++i) {
-                const int p = std::min(i, cols * rows - 1);
-                ex[i] = c.xc[size_t(bx + p % cols)];
-                ey[i] = c.yc[size_t(by + p / cols)];
-            }
-            xs[k] = ex;
-            ys[k] = ey;
+            float* ex = s.edge.data() + size_t(2 * kBatch * k);  // (a leaf cut by the image's edge)
+            leaf_inputs(c, bx, by, ex, ex + kBatch, xs[k], ys[k]);
         }
         s.sweep.eval(*ch.parent, ch.iv->choices(), ch.iv->stride(), bs.mask.data(), lanes, xs, ys, nullptr, c.time);
         for (int q = 0; q < ch.m; ++q) {

@@ -7,6 +7,7 @@
 // winner (nothing when it is already in place) or, for an immediate, a constant. Every op
 // computes exactly as the VM's handler for it does. A Guard never skips: skipping changes no
 // float (vm_kernel.inl), so running its region through gives the same values.
+
 // The lanes whose choice byte in a slot's row equals v: one compare of the row where the
 // copy has AVX-512BW (SDFC_SWEEP_BW, set by vm.cpp), else tape.hpp's.
 inline uint64_t sweep_lanes(const uint8_t* row, uint8_t v) {
@@ -59,7 +60,7 @@ void sweep(const Instr* code, const Tape::Link* links, size_t n, const uint64_t*
             [[maybe_unused]] const float* C = base[j] + oc;                          \
             if constexpr (Op::name == Op::VarX) copy(R, xs[j]);                      \
             else if constexpr (Op::name == Op::VarY) copy(R, ys[j]);                 \
-            else if constexpr (Op::name == Op::VarZ) copy(R, zs ? zs[j] : zeros);                    \
+            else if constexpr (Op::name == Op::VarZ) copy(R, zs ? zs[j] : zeros);    \
             else if constexpr (Op::name == Op::Time) std::fill_n(R, kBatch, time);   \
             else if constexpr (Op::name == Op::Guard) std::fill_n(R, kBatch, om::kSkipped); \
             else if constexpr (vmath::kVector<Op::name>) {                           \
