@@ -27,6 +27,9 @@ inline std::string slurp(const std::string& path) {
 inline std::string temp_dir() {
     static std::string dir = [] {
         std::string d = (std::filesystem::temp_directory_path() / ("sdfc-cli-" + std::to_string(::getpid()))).string();
+        // Empty: a process that had this pid before may have left files (pids wrap), and
+        // tests check that a failed command wrote none.
+        std::filesystem::remove_all(d);
         std::filesystem::create_directories(d);
         return d;
     }();

@@ -52,6 +52,7 @@ const std::string& validator() {
 fs::path scratch() {
     static const fs::path d = [] {
         fs::path p = fs::temp_directory_path() / fmt::format("sdfc-test-glsl-{}", getpid());
+        fs::remove_all(p);  // (an earlier process with this pid may have left files)
         fs::create_directories(p);
         return p;
     }();

@@ -25,6 +25,7 @@ const char* kScene =
 
 fs::path dir_for(const std::string& name) {
     fs::path d = fs::temp_directory_path() / ("sdfc-alpha-" + name + "-" + std::to_string(::getpid()));
+    fs::remove_all(d);  // (an earlier process with this pid may have left files)
     fs::create_directories(d);
     return d;
 }
