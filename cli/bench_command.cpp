@@ -65,13 +65,13 @@ int cmd_bench(Args& a) {
     auto per = [&](uint64_t v) { return double(v) / pixels; };
     const auto& by = stats.distance_points_by;
     std::printf("median_ms=%.3f min_ms=%.3f cold_ms=%.3f evals_per_pixel=%.2f rays=%.2f normals=%.2f shadows=%.2f ao=%.2f "
-                "shading=%.2f tape=%.0f/%zu tree_leaves=%llu tree_ms=%.1f tree_reused=%d skips=%.2f segment_skips=%.2f tile_skips=%llu shadow_cuts=%llu "
+                "shading=%.2f tape=%.0f/%zu tree_leaves=%llu tree_ms=%.1f tree_reused=%d skips=%.2f segment_skips=%.2f column_skips=%.2f tile_skips=%llu shadow_cuts=%llu "
                 "isa=%s\n",
                 median, sorted.front(), cold, per(stats.distance_points), per(by[RenderStats::kRays]),
                 per(by[RenderStats::kNormals]), per(by[RenderStats::kShadows]), per(by[RenderStats::kAo]),
                 per(stats.shading_points),
                 stats.distance_points ? double(stats.distance_instructions) / double(stats.distance_points) : 0.0,
-                cs.distance.code.size(), static_cast<unsigned long long>(stats.tree_leaves), stats.tree_ms, int(stats.tree_reused), per(stats.skips), per(stats.segment_skips),
+                cs.distance.code.size(), static_cast<unsigned long long>(stats.tree_leaves), stats.tree_ms, int(stats.tree_reused), per(stats.skips), per(stats.segment_skips), per(stats.column_skips),
                 static_cast<unsigned long long>(stats.tile_skips), static_cast<unsigned long long>(stats.shadow_cuts),
                 isa_name(current_isa()));
     return 0;

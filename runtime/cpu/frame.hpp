@@ -13,6 +13,7 @@
 #include "compiler/render/camera.hpp"
 #include "compiler/render/plan.hpp"
 #include "compiler/render/rules.h"
+#include "runtime/cpu/ray_columns.hpp"
 #include "runtime/cpu/tape_tree.hpp"
 #include "runtime/cpu/tracer.hpp"
 
@@ -34,6 +35,10 @@ struct Frame : RenderPlan {
     // Leaf 0 (the full distance program) at least; shared with other renders when kept
     // (tree_cache.hpp), and read-only once built.
     std::shared_ptr<const TapeTree> tree;
+    // A raw field's columns (ray_columns.hpp; null or empty: none): the camera's primary
+    // rays', and per light, a directional light's shadow rays'.
+    std::shared_ptr<const RayColumns> camera_columns;
+    std::vector<std::shared_ptr<const RayColumns>> light_columns;
     uint32_t max_regs = 1;          // registers of the longest distance tape: sizes the workers' VMs
     std::vector<Instr> shade_code;  // the shading program without the distance output's code
 

@@ -51,6 +51,7 @@ struct Lanes {
     alignas(64) float seg[kWindow];
     alignas(64) int32_t steps[kWindow], done[kWindow], idx[kWindow];
     alignas(64) uint32_t ray[kWindow], leaf[kWindow], tested[kWindow];
+    alignas(64) uint32_t place[kWindow];  // raw fields: the ray's place in its columns (RayColumns::clear_until)
     void load(int i, const RaySet& rs, uint32_t r, float relax) {
         ox[i] = rs.ox[r], oy[i] = rs.oy[r], oz[i] = rs.oz[r];
         dx[i] = rs.dx[r], dy[i] = rs.dy[r], dz[i] = rs.dz[r];
@@ -62,7 +63,7 @@ struct Lanes {
         ray[i] = r;
         for (int k = 0; k < 3; ++k) blo[k][i] = INFINITY, bhi[k][i] = -INFINITY;  // no leaf yet
         leaf[i] = 0, ivlo[i] = -INFINITY, ivhi[i] = INFINITY;
-        seg[i] = -INFINITY, tested[i] = 0;
+        seg[i] = -INFINITY, tested[i] = 0, place[i] = 0;
     }
     void set_leaf(int i, uint32_t id, const TapeTree::Leaf& L) {
         leaf[i] = id;
@@ -109,7 +110,7 @@ struct Lanes {
         x[to] = x[from], y[to] = y[from], z[to] = z[from], dist[to] = dist[from];
         for (int k = 0; k < 3; ++k) blo[k][to] = blo[k][from], bhi[k][to] = bhi[k][from];
         ivlo[to] = ivlo[from], ivhi[to] = ivhi[from], leaf[to] = leaf[from];
-        seg[to] = seg[from], tested[to] = tested[from];
+        seg[to] = seg[from], tested[to] = tested[from], place[to] = place[from];
         steps[to] = steps[from], done[to] = done[from], ray[to] = ray[from];
     }
     // Where ray i leaves the box [lo, hi] (its t; possibly a little below t[i] by rounding).

@@ -276,6 +276,7 @@ void Worker::march_raw(const RaySet& rs, bool shadow) {
     const int max_steps = f_.max_steps;
     const float inv_l = 1.0f / f_.raw_lipschitz;
     const float foot_base = f_.camera.footprint_base(), foot_slope = f_.camera.footprint_slope();
+    const RayColumns* cols = cols_;
     run(
         rs, [](Lanes& L, int i) { L.a[i] = -1.0f, L.pr[i] = NAN, L.sl[i] = 0.0f, L.om[i] = 0.0f; },
         [&](Lanes& L, int m, const float* dist) {
@@ -314,6 +315,12 @@ void Worker::march_raw(const RaySet& rs, bool shadow) {
             L.a[i] = t, L.pr[i] = NAN;  // (not evaluated: no secant from it)
             const float beyond = std::min(slo * inv_l, f_.raw_max_step);
             L.t[i] = tn + std::max(beyond, 0.25f * f_.footprint(L.t0[i] + tn) + 1e-6f * tn);
+            if (cols) {
+                // Nothing before the column's next run can change sign: the ray lands there,
+                // which is then the bracket's outside end too.
+                const float c = cols->clear_until(glm::vec3(L.ox[i], L.oy[i], L.oz[i]), glm::vec3(L.dx[i], L.dy[i], L.dz[i]), tn, L.tmax[i], L.place[i]);
+                if (c > L.t[i]) L.t[i] = c, L.a[i] = c, ++stats.column_skips;
+            }
             return true;
         },
         [](Lanes& L, int i) { L.om[i] = 0.0f, L.t[i] = L.tmax[i]; }, T_.active);

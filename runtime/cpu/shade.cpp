@@ -194,7 +194,8 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
     }
 
     // Direct light, one batched shadow pass per light.
-    for (const ResolvedLight& light : f_.lights) {
+    for (size_t li = 0; li < f_.lights.size(); ++li) {
+        const ResolvedLight& light = f_.lights[li];
         const glm::vec3 radiance = light.color * light.intensity;
         if (!(rules::sdf_max3(radiance) > 0.0f) || !std::isfinite(rules::sdf_max3(radiance))) continue;
         glm::vec3 ldir = -light.direction;
@@ -244,8 +245,10 @@ void Worker::shade(const RaySet& h, int gen, RaySet& next) {
         if (shadow_.size() == 0) continue;
         kind_ = RenderStats::kShadows;
         if (f_.raw) {
-            raw_shadow_cut(shadow_);
+            cols_ = li < f_.light_columns.size() ? f_.light_columns[li].get() : nullptr;  // (shadow rays run along the light)
+            if (!cols_) raw_shadow_cut(shadow_);  // (the columns end the rays where it would)
             march_raw(shadow_, true);
+            cols_ = nullptr;
         } else if (light.radius > 0.0f) {
             shadow_soft(shadow_);
         } else {

@@ -51,7 +51,11 @@ void Worker::render_tile(int x0, int y0, int x1, int y1, Image& img, AovPlane* d
     hits_.clear();
     if (f_.has_distance) {
         if (f_.cone) cone_march(rays_);
-        else march(rays_);
+        else {
+            cols_ = f_.camera_columns.get();  // (the primary rays are the camera's)
+            march(rays_);
+            cols_ = nullptr;
+        }
     } else {
         t_.assign(nprim, f_.max_dist), hit_.assign(nprim, 0), steps_.assign(nprim, 0), trans_.assign(nprim, 1.0f), ev_n_.assign(nprim, 0);
     }

@@ -107,6 +107,7 @@ void merge(RenderStats& total, const RenderStats& s) {
     total.tile_skips += s.tile_skips;
     total.shadow_cuts += s.shadow_cuts;
     total.segment_skips += s.segment_skips;
+    total.column_skips += s.column_skips;
     total.tree_leaves += s.tree_leaves;
     total.interval_boxes += s.interval_boxes;
     total.tree_ms += s.tree_ms;
@@ -166,6 +167,29 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
             in.samples = static_cast<size_t>(f.width) * static_cast<size_t>(f.height) * static_cast<size_t>(f.samples);
             f.tree = cpu::shared_tree(scene.distance, in, options.reuse_tree, &tree_reused);
             tree_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+        }
+        // A raw field's rays of the camera and of directional lights go from run to run of
+        // their columns (ray_columns.hpp; rays clipped to the box, whose ends are in the root).
+        if (f.raw && f.tree->active && f.clip && f.planes.empty()) {
+            const bool lights = f.shadows && f.view == RenderView::Shaded;
+            if (lights) f.light_columns.resize(f.lights.size());
+            const rules::SdfCamera& cam = f.camera.rule_camera();
+            tbb::parallel_for(size_t(0), f.lights.size() + 1, [&](size_t k) {
+                cpu::ColumnsKey key;
+                if (k == f.lights.size()) {
+                    if (f.cone) return;
+                    key.dir = cam.fwd;
+                    if (!cam.ortho) {
+                        // (cells of about 2 x 2 pixels)
+                        key.central = true, key.u = cam.right, key.v = cam.up, key.eye = cam.eye;
+                        key.half_u = cam.half_w, key.half_v = cam.half_h, key.cells_u = (f.width + 1) / 2, key.cells_v = (f.height + 1) / 2;
+                    }
+                    f.camera_columns = cpu::shared_ray_columns(f.tree, key, options.reuse_tree);
+                } else if (lights && f.lights[k].directional) {
+                    key.dir = -f.lights[k].direction;
+                    f.light_columns[k] = cpu::shared_ray_columns(f.tree, key, options.reuse_tree);
+                }
+            });
         }
         f.max_regs = std::max<uint32_t>(f.tree->max_regs, std::max<uint32_t>(scene.distance.num_regs, 1));
     });

@@ -89,6 +89,7 @@ struct RenderStats {
     uint64_t tile_skips = 0;
     uint64_t shadow_cuts = 0;  // a raw field's shadow ray sets cut short (raw_shadow_cut)
     uint64_t segment_skips = 0;  // of skips: a raw field's rays through cells not empty (segment_bounds)
+    uint64_t column_skips = 0;   // of skips: a raw field's rays carried on to their column's next run (ray_columns.hpp)
     uint64_t tree_leaves = 0, interval_boxes = 0;
     double tree_ms = 0.0;       // building the tree, or finding the kept one
     bool tree_reused = false;   // the tree was the one kept from an earlier render (RenderOptions::reuse_tree)

@@ -52,6 +52,7 @@ private:
     std::vector<uint32_t> local_, sh_idx_;
     std::vector<float> lw_, lnx_, lny_, lnz_, ao_, lrad_;
     uint32_t pleaf_[kWindow], merged_[kWindow];
+    const RayColumns* cols_ = nullptr;  // the columns of the rays march_raw marches (null: none)
     int kind_ = RenderStats::kRays;  // what the distance evaluations are for (stats)
     alignas(64) float gx_[kBatch], gy_[kBatch], gz_[kBatch];
 

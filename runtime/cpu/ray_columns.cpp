@@ -1,0 +1,220 @@
+// Building a family of rays' columns (ray_columns.hpp): each leaf not proven empty is
+// projected onto the plane of the columns' cells (along the light, or from the eye: a
+// rectangle of cells holds its box's projection) and gives every column it covers the run
+// of depth its box spans; a column's runs are then sorted and merged.
+#include "runtime/cpu/ray_columns.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <mutex>
+
+#include "compiler/render/rules.h"
+
+namespace sdfc::cpu {
+
+namespace {
+
+// The most cells across (a column per cell: memory and build time grow with its square),
+// and of leaves' rectangles' cells in all (the build's time).
+constexpr int kMaxCells = 1024;
+constexpr size_t kMaxEntries = size_t(4) << 20;
+
+}  // namespace
+
+std::shared_ptr<const RayColumns> build_ray_columns(const TapeTree& T, const ColumnsKey& key) {
+    if (!T.active || T.boxes_.empty() || !(glm::dot(key.dir, key.dir) > 0.0f)) return nullptr;
+    auto C = std::make_shared<RayColumns>();
+    RayColumns& c = *C;
+    c.central = key.central;
+    c.dir = glm::normalize(key.dir);
+    if (c.central) {
+        c.u = key.u, c.v = key.v, c.eye = key.eye;
+    } else {
+        // Across the light: any unit vector not along it, then the third by the cross product.
+        const glm::vec3 a = std::abs(c.dir.x) < 0.6f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+        c.u = glm::normalize(glm::cross(c.dir, a));
+        c.v = glm::cross(c.dir, c.u);
+    }
+    const glm::vec3 au = glm::abs(c.u), av = glm::abs(c.v), ad = glm::abs(c.dir);
+
+    const TapeTree::NodeBox& R = T.boxes_[0];
+    const glm::vec3 rlo(R.lo[0], R.lo[1], R.lo[2]), rhi(R.hi[0], R.hi[1], R.hi[2]);
+    // A margin over the rounding of the rays' own points and of these projections (as in
+    // raw_shadow_cut).
+    float big = std::max(rules::sdf_max3(glm::abs(rlo)), rules::sdf_max3(glm::abs(rhi)));
+    if (c.central) big = std::max(big, rules::sdf_max3(glm::abs(c.eye)));
+    if (!std::isfinite(big)) return nullptr;
+    const float g = 1e-5f * (1.0f + big);
+    c.root_lo = rlo + g, c.root_hi = rhi - g;
+
+    std::vector<uint32_t> full;  // the leaves not proven empty
+    float finest = INFINITY;
+    for (uint32_t l = 1; l < T.leaves.size(); ++l) {
+        const TapeTree::Leaf& L = T.leaves[l];
+        if (L.ivlo > 0.0f) continue;
+        full.push_back(l);
+        finest = std::min(finest, rules::sdf_max3(glm::vec3(L.hi[0] - L.lo[0], L.hi[1] - L.lo[1], L.hi[2] - L.lo[2])));
+    }
+    // Each leaf's rectangle in the plane of the cells, and the run of depth its box spans.
+    struct Proj {
+        float a0, a1, b0, b1, s0, s1;
+    };
+    std::vector<Proj> proj;
+    proj.reserve(full.size());
+    float plo_u, phi_u, plo_v, phi_v;  // the plane's part the columns cover
+    if (c.central) {
+        if (!(key.half_u > 0.0f && key.half_v > 0.0f && key.cells_u > 0 && key.cells_v > 0)) return nullptr;
+        plo_u = -key.half_u, phi_u = key.half_u, plo_v = -key.half_v, phi_v = key.half_v;
+    } else {
+        const glm::vec3 rc = 0.5f * (rlo + rhi), rh = 0.5f * (rhi - rlo);
+        const float ru = glm::dot(rh, au) + g, rv = glm::dot(rh, av) + g;
+        plo_u = glm::dot(rc, c.u) - ru, phi_u = glm::dot(rc, c.u) + ru, plo_v = glm::dot(rc, c.v) - rv, phi_v = glm::dot(rc, c.v) + rv;
+    }
+    for (uint32_t l : full) {
+        const TapeTree::Leaf& L = T.leaves[l];
+        const glm::vec3 lo = glm::vec3(L.lo[0], L.lo[1], L.lo[2]) - g, hi = glm::vec3(L.hi[0], L.hi[1], L.hi[2]) + g;
+        Proj P;
+        if (c.central) {
+            // The box's corners seen from the eye: their tangents bound the box's (all in
+            // front); a box reaching the eye's plane covers every column.
+            P.a0 = P.b0 = INFINITY, P.a1 = P.b1 = -INFINITY, P.s1 = 0.0f;
+            bool front = true, ahead = false;
+            for (int k = 0; k < 8; ++k) {
+                const glm::vec3 q = glm::vec3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z) - c.eye;
+                const float w = glm::dot(q, c.dir);
+                P.s1 = std::max(P.s1, glm::length(q));
+                front = front && w > 1e-3f * glm::length(q);
+                ahead = ahead || w > 0.0f;
+                const float a = glm::dot(q, c.u) / w, b = glm::dot(q, c.v) / w;
+                P.a0 = std::min(P.a0, a), P.a1 = std::max(P.a1, a), P.b0 = std::min(P.b0, b), P.b1 = std::max(P.b1, b);
+            }
+            P.s0 = glm::length(glm::clamp(c.eye, lo, hi) - c.eye);
+            P.s0 = std::max(P.s0 * (1.0f - 1e-6f) - g, 0.0f), P.s1 = P.s1 * (1.0f + 1e-6f) + g;
+            if (!ahead) continue;  // (behind the eye: its rays never get there)
+            if (!front) {
+                P.a0 = plo_u, P.a1 = phi_u, P.b0 = plo_v, P.b1 = phi_v;
+            } else {
+                const float m = 1e-6f * (1.0f + std::max({std::abs(P.a0), std::abs(P.a1), std::abs(P.b0), std::abs(P.b1)}));
+                P.a0 -= m, P.a1 += m, P.b0 -= m, P.b1 += m;
+            }
+        } else {
+            const glm::vec3 m = 0.5f * (lo + hi), h = 0.5f * (hi - lo);
+            const float pu = glm::dot(m, c.u), hu = glm::dot(h, au) + g;
+            const float pv = glm::dot(m, c.v), hv = glm::dot(h, av) + g;
+            const float ps = glm::dot(m, c.dir), hs = glm::dot(h, ad) + g;
+            P = Proj{pu - hu, pu + hu, pv - hv, pv + hv, ps - hs, ps + hs};
+        }
+        P.a0 = std::max(P.a0, plo_u), P.a1 = std::min(P.a1, phi_u), P.b0 = std::max(P.b0, plo_v), P.b1 = std::min(P.b1, phi_v);
+        if (!(P.a0 <= P.a1 && P.b0 <= P.b1 && P.s0 <= P.s1)) continue;  // (no column of the family meets it; NaN)
+        proj.push_back(P);
+    }
+
+    // Cells as small as the finest leaf (a light's) or about 2 x 2 pixels (the camera's),
+    // but at most kMaxCells across and, over all the leaves, kMaxEntries rectangle cells
+    // (a tree left coarse by its budget: bigger cells, a bounded build).
+    const float span_u = phi_u - plo_u, span_v = phi_v - plo_v;
+    float cell = c.central ? std::max(span_u / float(key.cells_u), span_v / float(key.cells_v))
+                           : (std::isfinite(finest) ? finest : std::max(span_u, span_v));
+    cell = std::max(cell, std::max(span_u, span_v) / float(kMaxCells));
+    if (!(cell > 0.0f) || !std::isfinite(cell)) return nullptr;
+    for (int k = 0; k < 16; ++k) {
+        double entries = 0.0;
+        for (const Proj& P : proj)
+            entries += (std::floor((P.a1 - plo_u) / cell) - std::floor((P.a0 - plo_u) / cell) + 1.0) *
+                       (std::floor((P.b1 - plo_v) / cell) - std::floor((P.b0 - plo_v) / cell) + 1.0);
+        if (entries <= double(kMaxEntries)) break;
+        cell *= 2.0f;
+    }
+    c.u0 = plo_u, c.v0 = plo_v;
+    c.inv_cell = 1.0f / cell;
+    c.nu = std::clamp(int(std::ceil(span_u * c.inv_cell)) + 1, 1, kMaxCells + 2);
+    c.nv = std::clamp(int(std::ceil(span_v * c.inv_cell)) + 1, 1, kMaxCells + 2);
+    const size_t columns = size_t(c.nu) * size_t(c.nv);
+
+    // The leaves' rectangles of cells, in the order of their runs' starts, so that each
+    // column's runs come sorted and merge as they arrive: one pass counts the merged runs,
+    // the next writes them.
+    struct Span {
+        float s0, s1;
+        int u0, u1, v0, v1;
+    };
+    std::vector<Span> spans;
+    spans.reserve(proj.size());
+    auto cell_of = [](float x, float x0, float inv, int n) { return std::clamp(int(std::floor((x - x0) * inv)), 0, n - 1); };
+    for (const Proj& P : proj)
+        spans.push_back(Span{P.s0, P.s1, cell_of(P.a0, c.u0, c.inv_cell, c.nu), cell_of(P.a1, c.u0, c.inv_cell, c.nu),
+                             cell_of(P.b0, c.v0, c.inv_cell, c.nv), cell_of(P.b1, c.v0, c.inv_cell, c.nv)});
+    std::sort(spans.begin(), spans.end(), [](const Span& p, const Span& q) { return p.s0 < q.s0; });
+    std::vector<float> end(columns, -INFINITY);
+    std::vector<uint32_t> start(columns + 1, 0);
+    for (const Span& S : spans)
+        for (int y = S.v0; y <= S.v1; ++y)
+            for (size_t k = size_t(y) * c.nu + S.u0, ke = size_t(y) * c.nu + S.u1; k <= ke; ++k) {
+                start[k + 1] += S.s0 > end[k];
+                end[k] = std::max(end[k], S.s1);
+            }
+    // Room for each column's runs and its end mark, after the empty columns' mark.
+    for (size_t k = 0; k < columns; ++k) start[k + 1] += start[k] + (start[k + 1] > 0);
+    const glm::vec2 mark(INFINITY, INFINITY);
+    c.runs.assign(start[columns] + 1, mark);
+    c.first.resize(columns);
+    std::vector<uint32_t> next(columns);
+    for (size_t k = 0; k < columns; ++k) {
+        const bool empty = start[k + 1] == start[k];
+        c.first[k] = empty ? 0 : start[k] + 1;
+        next[k] = c.first[k];
+    }
+    for (const Span& S : spans)
+        for (int y = S.v0; y <= S.v1; ++y)
+            for (size_t k = size_t(y) * c.nu + S.u0, ke = size_t(y) * c.nu + S.u1; k <= ke; ++k) {
+                if (next[k] > c.first[k] && S.s0 <= c.runs[next[k] - 1].y) {
+                    c.runs[next[k] - 1].y = std::max(c.runs[next[k] - 1].y, S.s1);
+                } else {
+                    c.runs[next[k]++] = glm::vec2(S.s0, S.s1);
+                }
+            }
+    return C;
+}
+
+namespace {
+
+// The columns built last, for the renders after them with the same tree and light (the
+// frames of a still camera, `sdfc bench`'s repeats). The tree is held weakly: a new tree
+// at a freed tree's address must not match.
+struct KeptColumns {
+    std::weak_ptr<const TapeTree> tree;
+    const TapeTree* raw = nullptr;
+    ColumnsKey key;
+    std::shared_ptr<const RayColumns> columns;
+};
+
+bool same_key(const ColumnsKey& a, const ColumnsKey& b) {
+    auto same = [](const glm::vec3& p, const glm::vec3& q) { return std::memcmp(&p, &q, sizeof p) == 0; };
+    return a.central == b.central && same(a.dir, b.dir) && same(a.u, b.u) && same(a.v, b.v) && same(a.eye, b.eye) &&
+           std::memcmp(&a.half_u, &b.half_u, sizeof a.half_u) == 0 && std::memcmp(&a.half_v, &b.half_v, sizeof a.half_v) == 0 &&
+           a.cells_u == b.cells_u && a.cells_v == b.cells_v;
+}
+constexpr size_t kKeptColumns = 4;
+std::mutex kept_mutex;
+std::vector<KeptColumns> kept;
+
+}  // namespace
+
+std::shared_ptr<const RayColumns> shared_ray_columns(const std::shared_ptr<const TapeTree>& T, const ColumnsKey& key, bool keep) {
+    if (!T) return nullptr;
+    if (keep) {
+        const std::lock_guard<std::mutex> lock(kept_mutex);
+        for (const KeptColumns& k : kept)
+            if (k.raw == T.get() && k.tree.lock() == T && same_key(k.key, key)) return k.columns;
+    }
+    std::shared_ptr<const RayColumns> c = build_ray_columns(*T, key);
+    if (keep && c) {
+        const std::lock_guard<std::mutex> lock(kept_mutex);
+        std::erase_if(kept, [](const KeptColumns& k) { return k.tree.expired(); });
+        if (kept.size() >= kKeptColumns) kept.erase(kept.begin());
+        kept.push_back(KeptColumns{T, T.get(), key, c});
+    }
+    return c;
+}
+
+}  // namespace sdfc::cpu
