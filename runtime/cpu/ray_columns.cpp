@@ -26,7 +26,8 @@ std::shared_ptr<const RayColumns> build_ray_columns(const TapeTree& T, const Col
     auto C = std::make_shared<RayColumns>();
     RayColumns& c = *C;
     c.central = key.central;
-    c.dir = glm::normalize(key.dir);
+    // (as the rays hold it, bit for bit: clear_until knows a parallel ray by its direction)
+    c.dir = std::abs(glm::dot(key.dir, key.dir) - 1.0f) < 1e-4f ? key.dir : glm::normalize(key.dir);
     if (c.central) {
         c.u = key.u, c.v = key.v, c.eye = key.eye;
     } else {

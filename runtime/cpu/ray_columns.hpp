@@ -78,9 +78,10 @@ struct RayColumns {
 };
 
 // The columns of the leaves of T that are not proven positive (ivlo > 0), for rays along
-// `dir` (unit), or, when `central`, for rays from `eye` whose tangents in the frame (u, v,
-// dir) lie in [-half_u, half_u] x [-half_v, half_v], in about `cells_u` x `cells_v` cells
-// (fewer when the leaves are coarser). Null when T has no tree.
+// `dir` (unit, and the very floats the rays hold), or, when `central`, for rays from `eye`
+// whose tangents in the frame (u, v, dir) lie in [-half_u, half_u] x [-half_v, half_v], in
+// about `cells_u` x `cells_v` cells (fewer when the leaves are coarser). Null when T has no
+// tree.
 struct ColumnsKey {
     bool central = false;
     glm::vec3 dir{0}, u{0}, v{0}, eye{0};

@@ -186,7 +186,7 @@ Image render(const CompiledScene& scene, const RenderOptions& options, RenderSta
                     }
                     f.camera_columns = cpu::shared_ray_columns(f.tree, key, options.reuse_tree);
                 } else if (lights && f.lights[k].directional) {
-                    key.dir = -f.lights[k].direction;
+                    key.dir = glm::normalize(-f.lights[k].direction);  // (as shade.cpp's shadow rays hold it)
                     f.light_columns[k] = cpu::shared_ray_columns(f.tree, key, options.reuse_tree);
                 }
             });

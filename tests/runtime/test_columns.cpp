@@ -206,4 +206,12 @@ TEST_CASE("columns: an orthographic camera's rays are carried along parallel col
     INFO("column skips " << fast.column_skips << " of " << fast.skips << ", values off " << off << " of " << a.pixels.size());
     CHECK(fast.column_skips > 0);
     CHECK(off <= 60);
+
+    // Without shadows, only the camera's rays jump.
+    c->cs.render.shadows = false;
+    ro.baseline = false;
+    RenderStats cam;
+    render(c->cs, ro, &cam);
+    INFO("camera rays' column skips " << cam.column_skips << " of " << cam.skips);
+    CHECK(cam.column_skips > 0);
 }
