@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,25 @@ float finest_leaf(const cpu::TapeTree& T) {
     float f = INFINITY;
     for (uint32_t l = 1; l < T.leaves.size(); ++l) f = std::min(f, T.leaves[l].hi[0] - T.leaves[l].lo[0]);
     return f;
+}
+
+// `src` marked raw (as a .vm model is) and rendered, accelerated and as the baseline.
+struct RawPair {
+    std::unique_ptr<test::Compiled> c;
+    Image fast{1, 1, 3}, base{1, 1, 3};
+    RenderStats sf, sb;
+};
+RawPair render_raw(const std::string& src) {
+    RawPair p;
+    p.c = test::compile_text(src);
+    p.c->cs.raw_field = true;
+    RenderOptions ro;
+    ro.threads = 2;
+    p.fast = render(p.c->cs, ro, &p.sf);
+    ro.baseline = true;
+    p.base = render(p.c->cs, ro, &p.sb);
+    REQUIRE(p.fast.pixels.size() == p.base.pixels.size());
+    return p;
 }
 
 }  // namespace
@@ -149,15 +169,9 @@ TEST_CASE("columns: a raw field's camera and directional shadow rays go from run
     // sample by sample: the pictures are 36.8 dB apart, 59 values off by more than 8 levels
     // in 255, the same with the columns as without them (measured; the jumps 61,792 ->
     // 43,488): raw marching's own differences (test_accel.cpp).
-    auto c = test::compile_text(spheres("light(direction = [-0.4, -1, -0.3], intensity = 2);\n") + "translate([5, 3, 5]) sphere(0.3);\n");
-    c->cs.raw_field = true;
-    RenderOptions ro;
-    ro.threads = 2;
-    RenderStats fast, base;
-    const Image a = render(c->cs, ro, &fast);
-    ro.baseline = true;
-    const Image b = render(c->cs, ro, &base);
-    REQUIRE(a.pixels.size() == b.pixels.size());
+    RawPair r = render_raw(spheres("light(direction = [-0.4, -1, -0.3], intensity = 2);\n") + "translate([5, 3, 5]) sphere(0.3);\n");
+    const Image &a = r.fast, &b = r.base;
+    const RenderStats& fast = r.sf;
     // (PSNR of the 8-bit sRGB pictures, as test_accel.cpp measures)
     auto enc = [](float v) {
         v = std::clamp(v, 0.0f, 1.0f);
@@ -178,10 +192,11 @@ TEST_CASE("columns: a raw field's camera and directional shadow rays go from run
     CHECK(psnr >= 36.5);
 
     // The same scene as a distance: its rays step on distances, no columns.
-    c->cs.raw_field = false;
-    ro.baseline = false;
+    r.c->cs.raw_field = false;
+    RenderOptions ro;
+    ro.threads = 2;
     RenderStats d;
-    render(c->cs, ro, &d);
+    render(r.c->cs, ro, &d);
     CHECK(d.column_skips == 0);
 }
 
@@ -192,15 +207,9 @@ TEST_CASE("columns: an orthographic camera's rays are carried along parallel col
     // columns as without them (measured: raw marching's own differences).
     std::string src = spheres("light(direction = [-0.4, -1, -0.3], intensity = 2);\n") + "translate([5, 3, 5]) sphere(0.3);\n";
     src.replace(src.find("fov = 45"), 8, "projection = \"orthographic\", ortho_height = 14");
-    auto c = test::compile_text(src);
-    c->cs.raw_field = true;
-    RenderOptions ro;
-    ro.threads = 2;
-    RenderStats fast, base;
-    const Image a = render(c->cs, ro, &fast);
-    ro.baseline = true;
-    const Image b = render(c->cs, ro, &base);
-    REQUIRE(a.pixels.size() == b.pixels.size());
+    RawPair r = render_raw(src);
+    const Image &a = r.fast, &b = r.base;
+    const RenderStats& fast = r.sf;
     int off = 0;
     for (size_t i = 0; i < a.pixels.size(); ++i) off += std::abs(std::clamp(a.pixels[i], 0.0f, 1.0f) - std::clamp(b.pixels[i], 0.0f, 1.0f)) > 0.05f;
     INFO("column skips " << fast.column_skips << " of " << fast.skips << ", values off " << off << " of " << a.pixels.size());
@@ -208,10 +217,11 @@ TEST_CASE("columns: an orthographic camera's rays are carried along parallel col
     CHECK(off <= 60);
 
     // Without shadows, only the camera's rays jump.
-    c->cs.render.shadows = false;
-    ro.baseline = false;
+    r.c->cs.render.shadows = false;
+    RenderOptions ro;
+    ro.threads = 2;
     RenderStats cam;
-    render(c->cs, ro, &cam);
+    render(r.c->cs, ro, &cam);
     INFO("camera rays' column skips " << cam.column_skips << " of " << cam.skips);
     CHECK(cam.column_skips > 0);
 }
