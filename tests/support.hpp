@@ -12,6 +12,25 @@
 
 namespace sdfc::test {
 
+// A linear value as the 8-bit sRGB level a PNG would hold (0 .. 255).
+inline float srgb8(float v) {
+    v = v < 0.0f ? 0.0f : (v > 1.0f ? 1.0f : v);  // (NaN stays NaN)
+    const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+    return std::round(s * 255.0f);
+}
+
+// PSNR of two pictures of the same size as 8-bit sRGB (what PNGs would hold), in dB; 200
+// when they are the same.
+inline double psnr_srgb8(const Image& a, const Image& b) {
+    double se = 0.0;
+    for (size_t i = 0; i < a.pixels.size(); ++i) {
+        const double d = (srgb8(a.pixels[i]) - srgb8(b.pixels[i])) / 255.0;
+        se += d * d;
+    }
+    const double mse = se / static_cast<double>(a.pixels.size());
+    return mse == 0.0 ? 200.0 : 10.0 * std::log10(1.0 / mse);
+}
+
 struct Compiled {
     SourceManager sm;
     Scene scene;

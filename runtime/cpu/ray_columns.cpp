@@ -146,14 +146,17 @@ std::shared_ptr<const RayColumns> build_ray_columns(const TapeTree& T, const Col
         spans.push_back(Span{P.s0, P.s1, cell_of(P.a0, c.u0, c.inv_cell, c.nu), cell_of(P.a1, c.u0, c.inv_cell, c.nu),
                              cell_of(P.b0, c.v0, c.inv_cell, c.nv), cell_of(P.b1, c.v0, c.inv_cell, c.nv)});
     std::sort(spans.begin(), spans.end(), [](const Span& p, const Span& q) { return p.s0 < q.s0; });
+    auto each_cell = [&](const Span& S, auto&& fn) {  // fn(column) for the cells of S's rectangle
+        for (int y = S.v0; y <= S.v1; ++y)
+            for (size_t k = size_t(y) * c.nu + S.u0, ke = size_t(y) * c.nu + S.u1; k <= ke; ++k) fn(k);
+    };
     std::vector<float> end(columns, -INFINITY);
     std::vector<uint32_t> start(columns + 1, 0);
     for (const Span& S : spans)
-        for (int y = S.v0; y <= S.v1; ++y)
-            for (size_t k = size_t(y) * c.nu + S.u0, ke = size_t(y) * c.nu + S.u1; k <= ke; ++k) {
-                start[k + 1] += S.s0 > end[k];
-                end[k] = std::max(end[k], S.s1);
-            }
+        each_cell(S, [&](size_t k) {
+            start[k + 1] += S.s0 > end[k];
+            end[k] = std::max(end[k], S.s1);
+        });
     // Room for each column's runs and its end mark, after the empty columns' mark.
     for (size_t k = 0; k < columns; ++k) start[k + 1] += start[k] + (start[k + 1] > 0);
     const glm::vec2 mark(INFINITY, INFINITY);
@@ -166,14 +169,10 @@ std::shared_ptr<const RayColumns> build_ray_columns(const TapeTree& T, const Col
         next[k] = c.first[k];
     }
     for (const Span& S : spans)
-        for (int y = S.v0; y <= S.v1; ++y)
-            for (size_t k = size_t(y) * c.nu + S.u0, ke = size_t(y) * c.nu + S.u1; k <= ke; ++k) {
-                if (next[k] > c.first[k] && S.s0 <= c.runs[next[k] - 1].y) {
-                    c.runs[next[k] - 1].y = std::max(c.runs[next[k] - 1].y, S.s1);
-                } else {
-                    c.runs[next[k]++] = glm::vec2(S.s0, S.s1);
-                }
-            }
+        each_cell(S, [&](size_t k) {
+            if (next[k] > c.first[k] && S.s0 <= c.runs[next[k] - 1].y) c.runs[next[k] - 1].y = std::max(c.runs[next[k] - 1].y, S.s1);
+            else c.runs[next[k]++] = glm::vec2(S.s0, S.s1);
+        });
     return C;
 }
 
@@ -184,7 +183,6 @@ namespace {
 // at a freed tree's address must not match.
 struct KeptColumns {
     std::weak_ptr<const TapeTree> tree;
-    const TapeTree* raw = nullptr;
     ColumnsKey key;
     std::shared_ptr<const RayColumns> columns;
 };
@@ -206,14 +204,14 @@ std::shared_ptr<const RayColumns> shared_ray_columns(const std::shared_ptr<const
     if (keep) {
         const std::lock_guard<std::mutex> lock(kept_mutex);
         for (const KeptColumns& k : kept)
-            if (k.raw == T.get() && k.tree.lock() == T && same_key(k.key, key)) return k.columns;
+            if (k.tree.lock() == T && same_key(k.key, key)) return k.columns;
     }
     std::shared_ptr<const RayColumns> c = build_ray_columns(*T, key);
     if (keep && c) {
         const std::lock_guard<std::mutex> lock(kept_mutex);
         std::erase_if(kept, [](const KeptColumns& k) { return k.tree.expired(); });
         if (kept.size() >= kKeptColumns) kept.erase(kept.begin());
-        kept.push_back(KeptColumns{T, T.get(), key, c});
+        kept.push_back(KeptColumns{T, key, c});
     }
     return c;
 }

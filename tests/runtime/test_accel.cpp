@@ -28,18 +28,7 @@ double psnr(const Image& a, const Image& b) {
     REQUIRE(a.width == b.width);
     REQUIRE(a.height == b.height);
     REQUIRE(a.pixels.size() == b.pixels.size());
-    auto enc = [](float v) {
-        v = std::clamp(v, 0.0f, 1.0f);
-        const float s = v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-        return std::round(s * 255.0f) / 255.0f;
-    };
-    double se = 0.0;
-    for (size_t i = 0; i < a.pixels.size(); ++i) {
-        const double d = enc(a.pixels[i]) - enc(b.pixels[i]);
-        se += d * d;
-    }
-    const double mse = se / static_cast<double>(a.pixels.size());
-    return mse == 0.0 ? 200.0 : 10.0 * std::log10(1.0 / mse);
+    return test::psnr_srgb8(a, b);
 }
 
 // A k x k grid of spheres on a floor, seen from above at an angle, one light.
