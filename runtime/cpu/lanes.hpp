@@ -42,6 +42,9 @@ static_assert(kWindow % kBatch == 0);
 // `sign` is +1 for a ray outside solids, -1 inside (it marches on -d).
 struct Lanes {
     alignas(64) float ox[kWindow], oy[kWindow], oz[kWindow], dx[kWindow], dy[kWindow], dz[kWindow];
+    // 1 / d per axis (0 where d is 0, or too small to leave a box by: |d| < 1e-30), for exit_t
+    // (three divisions a box instead of one a ray).
+    alignas(64) float ix[kWindow], iy[kWindow], iz[kWindow];
     alignas(64) float t[kWindow], tmax[kWindow], t0[kWindow], sign[kWindow], w[kWindow], a[kWindow], b[kWindow];
     alignas(64) float om[kWindow], pr[kWindow], sl[kWindow];
     alignas(64) float x[kWindow], y[kWindow], z[kWindow], dist[kWindow];
@@ -55,6 +58,7 @@ struct Lanes {
     void load(int i, const RaySet& rs, uint32_t r, float relax) {
         ox[i] = rs.ox[r], oy[i] = rs.oy[r], oz[i] = rs.oz[r];
         dx[i] = rs.dx[r], dy[i] = rs.dy[r], dz[i] = rs.dz[r];
+        ix[i] = inverse(dx[i]), iy[i] = inverse(dy[i]), iz[i] = inverse(dz[i]);
         t[i] = rs.tmin[r], tmax[i] = rs.tmax[r], t0[i] = rs.t0[r];
         sign[i] = rs.inside[r] ? -1.0f : 1.0f;
         w[i] = 0.0f, a[i] = 0.0f, b[i] = 0.0f;
@@ -104,6 +108,7 @@ struct Lanes {
     void move(int from, int to) {
         ox[to] = ox[from], oy[to] = oy[from], oz[to] = oz[from];
         dx[to] = dx[from], dy[to] = dy[from], dz[to] = dz[from];
+        ix[to] = ix[from], iy[to] = iy[from], iz[to] = iz[from];
         t[to] = t[from], tmax[to] = tmax[from], t0[to] = t0[from], sign[to] = sign[from];
         w[to] = w[from], a[to] = a[from], b[to] = b[from];
         om[to] = om[from], pr[to] = pr[from], sl[to] = sl[from];
@@ -116,13 +121,14 @@ struct Lanes {
     // Where ray i leaves the box [lo, hi] (its t; possibly a little below t[i] by rounding).
     float exit_t(int i, const float lo[3], const float hi[3]) const {
         float te = INFINITY;
-        const float o[3] = {ox[i], oy[i], oz[i]}, d[3] = {dx[i], dy[i], dz[i]};
+        const float o[3] = {ox[i], oy[i], oz[i]}, inv[3] = {ix[i], iy[i], iz[i]};
         for (int k = 0; k < 3; ++k) {
-            if (d[k] > 0.0f) te = std::min(te, (hi[k] - o[k]) / d[k]);
-            else if (d[k] < 0.0f) te = std::min(te, (lo[k] - o[k]) / d[k]);
+            if (inv[k] > 0.0f) te = std::min(te, (hi[k] - o[k]) * inv[k]);
+            else if (inv[k] < 0.0f) te = std::min(te, (lo[k] - o[k]) * inv[k]);
         }
         return te;
     }
+    static float inverse(float d) { return std::fabs(d) >= 1e-30f ? 1.0f / d : 0.0f; }
     // ... its leaf's box.
     float exit_t(int i) const {
         const float lo[3] = {blo[0][i], blo[1][i], blo[2][i]}, hi[3] = {bhi[0][i], bhi[1][i], bhi[2][i]};

@@ -130,7 +130,17 @@ void Worker::run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish
             // jumps depend on each other: the lanes' tree walks overlap instead of waiting).
             int nc = locate_lanes(L, n);
             bool any_out = false;
-            if (segments && nc == 0) nc = segment_bounds(L, n);
+            // Lanes to bound next: all of them the first time, then only those that landed
+            // in a leaf not empty for them since (no other lane's leaf or state changes).
+            bool scanned = false;
+            int np = 0;
+            alignas(64) int32_t pend[kWindow];
+            auto bound = [&] {
+                const int r = scanned ? segment_bounds(L, pend, np) : segment_bounds(L, nullptr, n);
+                scanned = true, np = 0;
+                return r;
+            };
+            if (segments && nc == 0) nc = bound();
             for (int it = 0; nc > 0 && it < 64; ++it) {
                 int moved = 0;
                 for (int j = 0; j < nc; ++j) {
@@ -154,10 +164,13 @@ void Worker::run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish
                 nc = 0;
                 for (int j = 0; j < moved; ++j) {
                     const int i = L.idx[j];
+                    const bool jumps = L.slo(i) > 0.0f;
                     L.idx[nc] = i;
-                    nc += L.slo(i) > 0.0f;
+                    nc += jumps;
+                    pend[np] = i;
+                    np += scanned & !jumps;  // (a lane that jumps again is pending after that)
                 }
-                if (segments && nc == 0) nc = segment_bounds(L, n);
+                if (segments && nc == 0) nc = bound();
             }
             if (segments)
                 for (int i = 0; i < n; ++i) L.seg[i] = -INFINITY;  // (each holds from its t only)
@@ -331,15 +344,17 @@ void Worker::march_raw(const RaySet& rs, bool shadow) {
 // box around that segment, in interval arithmetic (a segment's box is much smaller than the
 // leaf's, and a ray leaving a surface, or passing one, often clears it). Once per lane and
 // leaf, for lanes not refining whose leaves are not empty; by leaf, kIvLanes boxes a call.
-// Sets L.seg of the lanes proven and returns them in L.idx[0, return).
+// For the lanes lanes[0, n) (lanes [0, n) when null). Sets L.seg of the lanes proven and
+// returns them in L.idx[0, return).
 // Only for leaves of at most kSegmentTape instructions: over a long tape (bear.vm's leaves
 // keep 517 of its 525 instructions, exp and log among them) a bound costs more than the
 // steps it saves (3.1x the time).
 constexpr uint32_t kSegmentTape = 64;
 
-int Worker::segment_bounds(Lanes& L, int n) {
+int Worker::segment_bounds(Lanes& L, const int32_t* lanes, int n) {
     int m = 0;
-    for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+        const int i = lanes ? lanes[j] : j;
         const bool want = L.tested[i] != L.leaf[i] && L.leaf[i] != 0 && L.sl[i] == 0.0f && !(L.slo(i) > 0.0f) &&
                           T_.leaves[L.leaf[i]].len <= kSegmentTape;
         L.idx[m] = i;

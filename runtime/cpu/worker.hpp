@@ -153,7 +153,7 @@ private:
     template <class Init, class Update, class Finish, class Empty, class Skip, class Out>
     void run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish, Empty&& empty, Skip&& skip, Out&& out,
              bool segments = false);
-    int segment_bounds(Lanes& L, int n);
+    int segment_bounds(Lanes& L, const int32_t* lanes, int n);
     bool skip_sphere(Lanes& L, int i, float slo, float te);
     template <class Skip>
     bool jump(Lanes& L, int i, Skip& skip);
