@@ -187,6 +187,34 @@ TEST_CASE("rules: relaxed steps, hits, and the raw field's secant steps and refi
     CHECK_FALSE(
         rules::sdf_raw_step(0.5f, 0.0f, 10.0f, false, 2, 256, 1e-4f, 0.0f, 1e-3f, 1e-3f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
     CHECK(rt == Approx(0.5f + 0.5e-3f).epsilon(1e-6));
+    // A camera ray whose secant (1 at 0, 1e-5 at 1) puts the zero 1e-5 ahead, inside its
+    // footprint step (1e-3): half a threshold (0.5e-4) past the zero instead, marked in hi.
+    rt = 1.0f, prev = 0.0f, pv = 1.0f, hi = 0.0f, refine = 0.0f;
+    CHECK_FALSE(
+        rules::sdf_raw_step(1e-5f, 0.0f, 10.0f, false, 2, 256, 1e-4f, 0.0f, 1e-3f, 1e-3f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
+    const float close_t = 1.0f + 1e-5f / (1.0f - 1e-5f) + 0.5e-4f;
+    CHECK(rt == Approx(close_t).epsilon(1e-7));
+    CHECK(hi == rt);
+    CHECK(prev == 1.0f);
+    // Negative there: the bracket [1, rt] is under a threshold: a hit at its outside end,
+    // with no refinement.
+    rhit = false;
+    CHECK(rules::sdf_raw_step(-1e-6f, 0.0f, 10.0f, false, 3, 256, 1e-4f, 0.0f, 1e-3f, 1e-3f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
+    CHECK(rhit);
+    CHECK(rt == 1.0f);
+    CHECK(refine == 0.0f);
+    // Positive there (a ray passing close to a surface): no second such step in a row, the
+    // footprint step (its secant's zero, 6e-5 ahead, is short of it).
+    rt = close_t, prev = 1.0f, pv = 1e-5f, hi = close_t, refine = 0.0f;
+    CHECK_FALSE(
+        rules::sdf_raw_step(5e-6f, 0.0f, 10.0f, false, 4, 256, 1e-4f, 0.0f, 1e-3f, 1e-3f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
+    CHECK(rt == Approx(close_t + 1e-3f * close_t).epsilon(1e-7));
+    CHECK(hi == close_t);
+    // A shadow ray takes its footprint step (any sign change ends it anyway).
+    rt = 1.0f, prev = 0.0f, pv = 1.0f, hi = 0.0f, refine = 0.0f;
+    CHECK_FALSE(
+        rules::sdf_raw_step(1e-5f, 0.0f, 10.0f, true, 2, 256, 1e-4f, 0.0f, 1e-3f, 1e-3f, 1.0f, rt, prev, pv, hi, fhi, refine, rhit));
+    CHECK(rt == Approx(1.0f + 1e-3f).epsilon(1e-7));
     CHECK(rules::sdf_to_srgb(0.0031308f) == Approx(0.04045f).epsilon(1e-3));
     CHECK(rules::sdf_to_srgb(2.0f) == 1.0f);
     CHECK(rules::sdf_grid_x(0, 5) == -1.0f);
