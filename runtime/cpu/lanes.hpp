@@ -150,17 +150,22 @@ struct Buckets {
     void build(const uint32_t* leaf, int n) {
         if (++cur == 0) std::fill_n(gen, kSlots, 0u), cur = 1;
         nb = 0;
+        uint32_t last = ~0u;  // (lanes come mostly in runs of one leaf: those skip the table)
+        uint16_t last_id = 0;
         for (int i = 0; i < n; ++i) {
             const uint32_t k = leaf[i];
-            uint32_t h = (k * 2654435761u) >> 22;  // 10 bits
-            while (gen[h] == cur && key[h] != k) h = (h + 1) & (kSlots - 1);
-            if (gen[h] != cur) {
-                gen[h] = cur, key[h] = k, id[h] = static_cast<uint16_t>(nb);
-                key_of[nb] = k, count[nb] = 0;
-                ++nb;
+            if (k != last) {
+                uint32_t h = (k * 2654435761u) >> 22;  // 10 bits
+                while (gen[h] == cur && key[h] != k) h = (h + 1) & (kSlots - 1);
+                if (gen[h] != cur) {
+                    gen[h] = cur, key[h] = k, id[h] = static_cast<uint16_t>(nb);
+                    key_of[nb] = k, count[nb] = 0;
+                    ++nb;
+                }
+                last = k, last_id = id[h];
             }
-            bucket[i] = id[h];
-            ++count[id[h]];
+            bucket[i] = last_id;
+            ++count[last_id];
         }
         int acc = 0;
         for (int b = 0; b < nb; ++b) start[b] = acc, acc += count[b];

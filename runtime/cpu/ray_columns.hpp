@@ -60,6 +60,17 @@ struct RayColumns {
         return first[size_t(int(cv)) * size_t(nu) + size_t(int(cu))] + 1;
     }
 
+    // clear_until for a ray's start, which need not be in the root box: t_start itself when
+    // it is not (the columns know nothing of what lies outside), so +inf only for a ray of
+    // the family that meets no leaf not proven empty up to t_end.
+    float first_run(const glm::vec3& o, const glm::vec3& d, float t_start, float t_end, uint32_t& at) const {
+        const glm::vec3 a = o + d * t_start;
+        if (!(a.x >= root_lo.x && a.x <= root_hi.x && a.y >= root_lo.y && a.y <= root_hi.y && a.z >= root_lo.z &&
+              a.z <= root_hi.z))
+            return t_start;
+        return clear_until(o, d, t_start, t_end, at);
+    }
+
     // Along the ray o + t d (one of the family's) from t, a point in the root box, as is
     // o + t_end d: the first t' >= t where it may meet a leaf not proven empty (t itself when
     // it may be in one now), or +inf when there is none. `at`: the ray's place (0 before its

@@ -35,6 +35,7 @@ float uniform() {
 
 struct Walk {
     int rays = 0, carried = 0, to_end = 0, wrong = 0;
+    int start_clear = 0, start_clear_agrees = 0;  // samples clear to the end, by clear_until and by first_run too
 };
 
 // Along the ray o + t d over [t0, t1] (in the root), samples a 16th of the finest leaf
@@ -62,6 +63,16 @@ void walk(const cpu::TapeTree& T, const cpu::RayColumns& C, glm::vec3 o, glm::ve
             ++w.wrong;
             FAIL_CHECK("carried from t = " << ts[j] << " to " << c << " past t = " << ts[k] << " (a leaf not proven empty)");
         }
+        // A ray starting there (first_run: a march moves its start there, or does not march
+        // it at all when that is past its end) obeys the same.
+        uint32_t fresh = 0;
+        const float f = C.first_run(o, d, ts[j], t1, fresh);
+        if (!(f >= ts[j]) || (k < ts.size() && ts[k] < f)) {
+            ++w.wrong;
+            FAIL_CHECK("a ray from t = " << ts[j] << " starts at " << f << " (first sample in a leaf not proven empty: "
+                                         << (k < ts.size() ? ts[k] : INFINITY) << ")");
+        }
+        if (c == INFINITY) ++w.start_clear, w.start_clear_agrees += f == INFINITY;
     }
 }
 
@@ -124,11 +135,18 @@ TEST_CASE("columns: no ray is carried past a leaf that may hold surface", "[colu
         INFO("rays " << w.rays << ", samples carried " << w.carried << ", to the end " << w.to_end);
         CHECK(w.wrong == 0);
         CHECK(w.to_end > w.rays / 2);  // (most of the root's height is clear above the spheres)
+        CHECK(w.start_clear > 0);
+        CHECK(w.start_clear_agrees == w.start_clear);
         // A ray not along the light is not the family's: the columns do not know it.
         uint32_t place = 0;
         const glm::vec3 d = glm::normalize(key.dir + glm::vec3(0.01f, 0, 0));
         CHECK(C->clear_until(glm::vec3(0, 0.9f, 0), d, 0.0f, 0.05f, place) == 0.0f);
         CHECK(place == cpu::RayColumns::kUnknown);
+        // A ray of the family starting outside the root: nothing is known there, it starts
+        // where it does.
+        const glm::vec3 below = glm::vec3(0.0f, lo.y - 1.0f, 0.0f);
+        place = 0;
+        CHECK(C->first_run(below, key.dir, 0.0f, 1.5f, place) == 0.0f);
     }
     SECTION("a camera's rays, from its eye") {
         const glm::vec3 eye(0, 9, 9), fwd = glm::normalize(-eye);
