@@ -76,27 +76,50 @@ std::shared_ptr<const RayColumns> build_ray_columns(const TapeTree& T, const Col
         const glm::vec3 lo = glm::vec3(L.lo[0], L.lo[1], L.lo[2]) - g, hi = glm::vec3(L.hi[0], L.hi[1], L.hi[2]) + g;
         Proj P;
         if (c.central) {
-            // The box's corners seen from the eye: their tangents bound the box's (all in
-            // front); a box reaching the eye's plane covers every column.
+            // The box seen from the eye: the tangents of its corners in front bound those of
+            // its part in front. A corner on (or near) the eye's plane, or a point where an edge
+            // crosses it, stands for points whose tangents run off to infinity on the sides of
+            // its offset across the view: a box beside the eye covers the columns on its side
+            // only, one around the eye all of them.
             P.a0 = P.b0 = INFINITY, P.a1 = P.b1 = -INFINITY, P.s1 = 0.0f;
-            bool front = true, ahead = false;
+            glm::vec3 q[8];
+            float w[8];
+            bool ahead = false, up_u = false, down_u = false, up_v = false, down_v = false;
+            auto on_plane = [&](const glm::vec3& p) {
+                const float a = glm::dot(p, c.u), b = glm::dot(p, c.v), d = 1e-3f * glm::length(p) + g;
+                up_u = up_u || a >= -d, down_u = down_u || a <= d, up_v = up_v || b >= -d, down_v = down_v || b <= d;
+            };
             for (int k = 0; k < 8; ++k) {
-                const glm::vec3 q = glm::vec3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z) - c.eye;
-                const float w = glm::dot(q, c.dir);
-                P.s1 = std::max(P.s1, glm::length(q));
-                front = front && w > 1e-3f * glm::length(q);
-                ahead = ahead || w > 0.0f;
-                const float a = glm::dot(q, c.u) / w, b = glm::dot(q, c.v) / w;
-                P.a0 = std::min(P.a0, a), P.a1 = std::max(P.a1, a), P.b0 = std::min(P.b0, b), P.b1 = std::max(P.b1, b);
+                q[k] = glm::vec3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z) - c.eye;
+                w[k] = glm::dot(q[k], c.dir);
+                const float len = glm::length(q[k]);
+                P.s1 = std::max(P.s1, len);
+                ahead = ahead || w[k] > 0.0f;
+                if (w[k] > 1e-3f * len) {
+                    const float a = glm::dot(q[k], c.u) / w[k], b = glm::dot(q[k], c.v) / w[k];
+                    P.a0 = std::min(P.a0, a), P.a1 = std::max(P.a1, a), P.b0 = std::min(P.b0, b), P.b1 = std::max(P.b1, b);
+                } else if (w[k] >= -1e-3f * len) {
+                    on_plane(q[k]);
+                }
             }
+            for (int k = 0; k < 8; ++k)
+                for (int axis = 1; axis < 8; axis <<= 1) {
+                    const int j = k | axis;  // (each edge once: from its corner with the bit clear)
+                    if ((k & axis) || (w[k] > 0.0f) == (w[j] > 0.0f)) continue;
+                    on_plane(q[k] + (q[j] - q[k]) * (w[k] / (w[k] - w[j])));
+                }
             P.s0 = glm::length(glm::clamp(c.eye, lo, hi) - c.eye);
             P.s0 = std::max(P.s0 * (1.0f - 1e-6f) - g, 0.0f), P.s1 = P.s1 * (1.0f + 1e-6f) + g;
             if (!ahead) continue;  // (behind the eye: its rays never get there)
-            if (!front) {
-                P.a0 = plo_u, P.a1 = phi_u, P.b0 = plo_v, P.b1 = phi_v;
+            if (!(P.a0 <= P.a1)) {
+                P.a0 = plo_u, P.a1 = phi_u, P.b0 = plo_v, P.b1 = phi_v;  // (no corner clearly in front)
             } else {
                 const float m = 1e-6f * (1.0f + std::max({std::abs(P.a0), std::abs(P.a1), std::abs(P.b0), std::abs(P.b1)}));
                 P.a0 -= m, P.a1 += m, P.b0 -= m, P.b1 += m;
+                if (up_u) P.a1 = phi_u;
+                if (down_u) P.a0 = plo_u;
+                if (up_v) P.b1 = phi_v;
+                if (down_v) P.b0 = plo_v;
             }
         } else {
             const glm::vec3 m = 0.5f * (lo + hi), h = 0.5f * (hi - lo);
