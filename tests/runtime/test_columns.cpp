@@ -148,25 +148,34 @@ TEST_CASE("columns: no ray is carried past a leaf that may hold surface", "[colu
         place = 0;
         CHECK(C->first_run(below, key.dir, 0.0f, 1.5f, place) == 0.0f);
     }
-    SECTION("a camera's rays, from its eye") {
-        const glm::vec3 eye(0, 9, 9), fwd = glm::normalize(-eye);
+    // A pinhole camera's columns (80 x 45 cells, vertical field of view `fov` degrees) and 300
+    // of its rays walked from the eye, or from where they enter the root.
+    auto camera_walk = [&](glm::vec3 eye, glm::vec3 fwd, float fov, std::shared_ptr<const cpu::RayColumns>& C) {
         const glm::vec3 right = glm::normalize(glm::cross(fwd, glm::vec3(0, 1, 0))), up = glm::cross(right, fwd);
         cpu::ColumnsKey key;
         key.central = true, key.dir = fwd, key.u = right, key.v = up, key.eye = eye;
-        key.half_v = std::tan(glm::radians(22.5f)), key.half_u = key.half_v * 16.0f / 9.0f;
+        key.half_v = std::tan(glm::radians(fov / 2.0f)), key.half_u = key.half_v * 16.0f / 9.0f;
         key.cells_u = 80, key.cells_v = 45;
-        const auto C = cpu::build_ray_columns(T, key);
-        REQUIRE(C);
-        CHECK(C->central);
+        C = cpu::build_ray_columns(T, key);
         Walk w;
+        if (!C) return w;
         for (int r = 0; r < 300; ++r) {
             const float a = (2.0f * uniform() - 1.0f) * key.half_u, b = (2.0f * uniform() - 1.0f) * key.half_v;
             const glm::vec3 d = glm::normalize(fwd + a * right + b * up);
             float ta, tb;
             clip(eye, d, ta, tb);
+            ta = std::max(ta, 0.0f);
             if (!(ta < tb)) continue;
             walk(T, *C, eye, d, ta, tb, h, w);
         }
+        return w;
+    };
+    SECTION("a camera's rays, from its eye") {
+        const glm::vec3 eye(0, 9, 9), fwd = glm::normalize(-eye);
+        std::shared_ptr<const cpu::RayColumns> C;
+        const Walk w = camera_walk(eye, fwd, 45.0f, C);
+        REQUIRE(C);
+        CHECK(C->central);
         INFO("rays " << w.rays << ", samples carried " << w.carried << ", to the end " << w.to_end);
         CHECK(w.rays > 150);
         CHECK(w.wrong == 0);
@@ -182,23 +191,9 @@ TEST_CASE("columns: no ray is carried past a leaf that may hold surface", "[colu
         // on its side of the view (all of them only when it holds the eye), so rays are still
         // carried over the open space (measured: 8,920 samples carried to the end; 74 when
         // every leaf reaching the eye's plane covered every column).
-        const glm::vec3 eye(0.1f, 0.5f, 0.2f), fwd = glm::normalize(glm::vec3(1, -0.1f, 0.7f));
-        const glm::vec3 right = glm::normalize(glm::cross(fwd, glm::vec3(0, 1, 0))), up = glm::cross(right, fwd);
-        cpu::ColumnsKey key;
-        key.central = true, key.dir = fwd, key.u = right, key.v = up, key.eye = eye;
-        key.half_v = std::tan(glm::radians(40.0f)), key.half_u = key.half_v * 16.0f / 9.0f;
-        key.cells_u = 80, key.cells_v = 45;
-        const auto C = cpu::build_ray_columns(T, key);
+        std::shared_ptr<const cpu::RayColumns> C;
+        const Walk w = camera_walk(glm::vec3(0.1f, 0.5f, 0.2f), glm::normalize(glm::vec3(1, -0.1f, 0.7f)), 80.0f, C);
         REQUIRE(C);
-        Walk w;
-        for (int r = 0; r < 300; ++r) {
-            const float a = (2.0f * uniform() - 1.0f) * key.half_u, b = (2.0f * uniform() - 1.0f) * key.half_v;
-            const glm::vec3 d = glm::normalize(fwd + a * right + b * up);
-            float ta, tb;
-            clip(eye, d, ta, tb);
-            if (!(0.0f < tb)) continue;
-            walk(T, *C, eye, d, 0.0f, tb, h, w);
-        }
         INFO("rays " << w.rays << ", samples carried " << w.carried << ", to the end " << w.to_end);
         CHECK(w.rays > 150);
         CHECK(w.wrong == 0);
