@@ -84,7 +84,9 @@ void Worker::retire(Lanes& L, int& n, Finish&& finish) {
 // ray is loaded; `update(L, n, d)` consumes the distances of lanes [0, n) (a vectorisable
 // loop that advances t and sets L.done); `finish(L, i)` records a finished lane. Rays
 // with an empty [tmin, tmax] go to `empty(r)` without an evaluation, and so do rays whose
-// columns (cols_, a raw field's) hold no run before their end.
+// columns (cols_, a raw field's) hold no run before their end; the others start at their
+// first run (a raw march's first sample there, with no previous one, decides as one after a
+// jump would: a sign change is a hit at it, no secant from before).
 // With a tape tree, a lane whose leaf is empty for it (signed lower bound slo > 0) may
 // jump: `skip(L, i, slo, t_exit)` decides (and sets L.t[i] and any state) or returns
 // false; a ray that jumps past tmax ends through `out(L, i)` (which sets a miss) and
@@ -108,13 +110,17 @@ void Worker::run(const RaySet& rs, Init&& init, Update&& update, Finish&& finish
                 empty(r);
                 continue;
             }
-            uint32_t place = 0;  // (in its columns)
-            if (cols_ && !(cols_->first_run(rs.o(r), rs.d(r), rs.tmin[r], rs.tmax[r], place) <= rs.tmax[r])) {
-                empty(r);  // (it meets no leaf not proven empty before its end: nothing to march)
+            // With columns (a raw field's: no sign change before a column's first run), the
+            // ray starts at its first run, and one with none before its end is not marched.
+            uint32_t place = 0;
+            const float start = cols_ ? cols_->first_run(rs.o(r), rs.d(r), rs.tmin[r], rs.tmax[r], place) : rs.tmin[r];
+            if (!(start <= rs.tmax[r])) {
+                empty(r);
                 continue;
             }
             L.load(n, rs, r, f_.relax);
             L.place[n] = place;
+            L.t[n] = std::max(L.t[n], start);
             init(L, n);
             if (tree) {
                 // Its first leaf from the one before's: the rays come in pixel order, so their
@@ -298,16 +304,7 @@ void Worker::march_raw(const RaySet& rs, bool shadow) {
     const float foot_base = f_.camera.footprint_base(), foot_slope = f_.camera.footprint_slope();
     const RayColumns* cols = cols_;
     run(
-        rs,
-        [&](Lanes& L, int i) {
-            L.a[i] = -1.0f, L.pr[i] = NAN, L.sl[i] = 0.0f, L.om[i] = 0.0f;
-            if (cols) {
-                // Nothing before its column's first run can change sign: the ray starts there,
-                // which is then the bracket's outside end (as after a jump).
-                const float c = cols->first_run(glm::vec3(L.ox[i], L.oy[i], L.oz[i]), glm::vec3(L.dx[i], L.dy[i], L.dz[i]), L.t[i], L.tmax[i], L.place[i]);
-                if (c > L.t[i]) L.t[i] = c, L.a[i] = c;
-            }
-        },
+        rs, [](Lanes& L, int i) { L.a[i] = -1.0f, L.pr[i] = NAN, L.sl[i] = 0.0f, L.om[i] = 0.0f; },
         [&](Lanes& L, int m, const float* dist) {
             // Sign-change marching with refinement (rules.h sdf_raw_step): a = previous t
             // (the bracket's outside end), pr = its value, w / b = the inside end and its

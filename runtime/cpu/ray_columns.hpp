@@ -42,10 +42,7 @@ struct RayColumns {
     // the columns know nothing of it (its end or column outside them, a ray not of the
     // family).
     uint32_t place(const glm::vec3& o, const glm::vec3& d, float t_end) const {
-        const glm::vec3 e = o + d * t_end;
-        if (!(e.x >= root_lo.x && e.x <= root_hi.x && e.y >= root_lo.y && e.y <= root_hi.y && e.z >= root_lo.z &&
-              e.z <= root_hi.z))
-            return kUnknown;  // (leaf 0 past the root: never skipped)
+        if (!in_root(o + d * t_end)) return kUnknown;  // (leaf 0 past the root: never skipped)
         float cu, cv;
         if (central) {
             const float w = glm::dot(d, dir);
@@ -64,11 +61,10 @@ struct RayColumns {
     // it is not (the columns know nothing of what lies outside), so +inf only for a ray of
     // the family that meets no leaf not proven empty up to t_end.
     float first_run(const glm::vec3& o, const glm::vec3& d, float t_start, float t_end, uint32_t& at) const {
-        const glm::vec3 a = o + d * t_start;
-        if (!(a.x >= root_lo.x && a.x <= root_hi.x && a.y >= root_lo.y && a.y <= root_hi.y && a.z >= root_lo.z &&
-              a.z <= root_hi.z))
-            return t_start;
-        return clear_until(o, d, t_start, t_end, at);
+        return in_root(o + d * t_start) ? clear_until(o, d, t_start, t_end, at) : t_start;
+    }
+    bool in_root(const glm::vec3& p) const {  // (NaN: no)
+        return p.x >= root_lo.x && p.x <= root_hi.x && p.y >= root_lo.y && p.y <= root_hi.y && p.z >= root_lo.z && p.z <= root_hi.z;
     }
 
     // Along the ray o + t d (one of the family's) from t, a point in the root box, as is
