@@ -20,6 +20,7 @@
 #include <tbb/parallel_for.h>
 
 #include <deque>
+#include <limits>
 #include <memory>
 #include <queue>
 
@@ -100,12 +101,19 @@ uint8_t split_axes(const TreeCell& c) {
     return axes ? axes : uint8_t(7);  // (NaN extents: all, as before)
 }
 
+// A raw field's cell whose values are proven not negative holds no sign change (at most
+// zeros: a sheet of zero thickness, which the marches do not take for a surface): its
+// lower bound is raised from 0 to kSheet, so that it counts as empty.
+constexpr float kSheet = std::numeric_limits<float>::min();
+float raw_floor(float lo, float hi) { return lo >= 0.0f && lo < kSheet && hi > 0.0f ? kSheet : lo; }
+
 // Empty (ivlo > 0) or solid (ivhi < 0): no surface inside.
 bool settled(float ivlo, float ivhi) { return ivlo > 0.0f || ivhi < 0.0f; }
 // An empty or solid cell is still split when the surface is within `near` (kTreeNear) of its
 // size (rays, normal and AO taps and soft shadows evaluate there).
 bool near_surface(const TreeCell& c, float near) {
     const float size = rules::sdf_max3(c.hi - c.lo), d = c.ivlo > 0.0f ? c.ivlo : -c.ivhi;
+    if (c.ivlo == kSheet) return false;  // (no surface near: at most a sheet)
     return d < near * size;
 }
 
@@ -123,6 +131,7 @@ struct TreeScratch {
     uint32_t regs = 0, choices = 0;
     BatchScratch bs;
     std::vector<Tape::Link> links;  // lent to the cell being split
+    std::vector<uint32_t> fold;  // fold_abs's
     uint64_t boxes = 0;
     std::unique_ptr<BatchVM> vm;  // grows to the longest tape it runs
     IntervalEvaluator& get(uint32_t r, uint32_t c) {
@@ -151,6 +160,8 @@ public:
           max_nodes_(std::clamp(samples / (thin_layer ? kTreeThinSamplesPerNode : kTreeSamplesPerNode), kTreeMinNodes, kTreeMaxNodes)) {
         cells_[0].lo = lo, cells_[0].hi = hi;
         cells_[0].tape = Tape::from(p, 0);
+        std::vector<uint32_t> fold;
+        if (fold_abs(cells_[0].tape.code.data(), cells_[0].tape.code.size(), fold)) cells_[0].tape.link();
         cells_[0].tape.mark_min_chains();  // a union's far shapes go against its nearest anywhere
         consider(0);
     }
@@ -298,6 +309,7 @@ void TreeBuilder::split(TreeScratch& s, uint32_t i) {
     }
     bool kept = false;
     uint64_t lanes = 0;
+    size_t sheets = 0;  // children settled as sheets: surface cells whose tapes the split ended
     for (int k = 0; k < 8; ++k) {
         TreeCell& ch = cells_[first + static_cast<uint32_t>(k)];
         ch.lo = glm::vec3(bx[0][k], bx[2][k], bx[4][k]);
@@ -305,12 +317,14 @@ void TreeBuilder::split(TreeScratch& s, uint32_t i) {
         const Interval v = iv.result(k);
         const Interval t = std::isfinite(dc[k]) ? tighten_by_centre(v, dc[k], glm::length(ch.hi - ch.lo)) : v;
         ch.ivlo = t.lo, ch.ivhi = t.hi;
+        if (!lipschitz_) ch.ivlo = raw_floor(ch.ivlo, ch.ivhi);
         ch.depth = c.depth + 1;
         ch.unused = (k & ~c.axes) != 0;
         if (ch.unused) continue;  // (a copy of a used sibling's box)
         if (settled(ch.ivlo, ch.ivhi) && !(ch.depth < kTreeMaxDepth && c.tape.code.size() > kTreeLeafTape && near_surface(ch, near_))) {
             ch.ref_cell = i;  // will not be split: runs this cell's tape
             kept = true;
+            sheets += ch.ivlo == kSheet;
             continue;
         }
         lanes |= uint64_t(1) << k;
@@ -321,11 +335,23 @@ void TreeBuilder::split(TreeScratch& s, uint32_t i) {
         if (!((lanes >> k) & 1)) continue;
         TreeCell& ch = cells_[first + static_cast<uint32_t>(k)];
         ch.tape.assign(s.bs.code(k), s.bs.len[size_t(k)], s.bs.out[size_t(k)], s.bs.regs[size_t(k)]);
+        if (fold_abs(ch.tape.code.data(), ch.tape.code.size(), s.fold) && !lipschitz_ && !settled(ch.ivlo, ch.ivhi)) {
+            // A sheet of zero thickness may be all the surface the box has: its own
+            // interval, which knows abs(x) is not negative, says.
+            const float blo[3] = {ch.lo.x, ch.lo.y, ch.lo.z}, bhi[3] = {ch.hi.x, ch.hi.y, ch.hi.z};
+            iv.eval(ch.tape.view(), &blo[0], &bhi[0], &blo[1], &bhi[1], &blo[2], &bhi[2], 1, time_);
+            const Interval r = iv.result(0);
+            if (r.lo > ch.ivlo) ch.ivlo = r.lo;
+            if (r.hi < ch.ivhi) ch.ivhi = r.hi;
+            ch.ivlo = raw_floor(ch.ivlo, ch.ivhi);
+        }
         sum += ch.tape.code.size();
         ++nsimp;
     }
     // A split that left the children's tapes about as long as this one (an
-    // unprunable field) counts against splitting them again.
+    // unprunable field) counts against splitting them again. (Sheets count as tapes of no
+    // length: without the proof they were short surface tapes.)
+    nsimp += sheets;
     const bool useless = nsimp > 0 && sum * 10 >= c.tape.code.size() * nsimp * 9;
     for (int k = 0; k < 8; ++k) cells_[first + static_cast<uint32_t>(k)].stall = useless ? c.stall + 1 : 0;
     keep_[i] = kept;

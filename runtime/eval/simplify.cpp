@@ -298,6 +298,43 @@ void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint
     }
 }
 
+bool fold_abs(Instr* code, size_t count, std::vector<uint32_t>& scratch) {
+    // Value numbers: val[r] is the value register r holds; neg_of[v] the value v is the
+    // negation of (kNoValue: none).
+    constexpr uint32_t kNoValue = 0xFFFFFFFFu;
+    uint32_t regs = 1;
+    for (size_t i = 0; i < count; ++i) regs = std::max<uint32_t>(regs, uint32_t(std::max({code[i].out, code[i].a, code[i].b, code[i].c})) + 1);
+    scratch.assign(size_t(regs) + count + 1, kNoValue);
+    uint32_t* val = scratch.data();
+    uint32_t* neg_of = scratch.data() + regs;
+    bool changed = false;
+    for (size_t i = 0; i < count; ++i) {
+        Instr& in = code[i];
+        const uint32_t v = uint32_t(i);
+        if (in.op == Op::Copy) {
+            val[in.out] = val[in.a];
+            continue;
+        }
+        if (in.op == Op::Neg && val[in.a] != kNoValue) {
+            const uint32_t a = val[in.a];
+            if (neg_of[a] != kNoValue) {  // -(-x): x itself
+                val[in.out] = neg_of[a];
+                continue;
+            }
+            neg_of[v] = a;
+        } else if (in.op == Op::Max && val[in.a] != kNoValue && val[in.b] != kNoValue) {
+            const uint32_t a = val[in.a], b = val[in.b];
+            if (neg_of[a] == b || neg_of[b] == a) {
+                in.op = Op::Abs;
+                in.b = 0;
+                changed = true;
+            }
+        }
+        val[in.out] = v;
+    }
+    return changed;
+}
+
 void simplify_masks(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s) {
     if (lanes != 0 && followable(parent)) need_masks(parent, choices, stride, lanes, s.mask);
 }

@@ -63,6 +63,14 @@ struct BatchScratch {
 void simplify_batch(const Tape& parent, const uint8_t* choices, int stride, uint64_t lanes, BatchScratch& s,
                     bool compact = true);
 
+// Rewrites max(x, -x) (either order, through copies and double negations) as abs(x):
+// the same floats but for the sign of a zero result, and an interval that knows it is not
+// negative. A box where a simplification left this (coincident faces of a CSG model, whose
+// difference keeps a sheet of zero thickness) is then proven free of negative values.
+// Returns whether it rewrote anything (registers may be written more than once, as in any
+// tape: operands are followed by value, not by register).
+bool fold_abs(Instr* code, size_t count, std::vector<uint32_t>& scratch);
+
 // Only simplify_batch's backward pass: s.mask[i] holds the lanes needing instruction i of
 // `parent` (nothing when `parent` cannot be followed: not linked, or no output). SweepVM
 // (runtime/eval/vm.hpp) runs the lanes from these masks without making their tapes.

@@ -312,6 +312,43 @@ TEST_CASE("accel: a raw field's tiles of camera rays cross empty cells together"
     CHECK(psnr(r.accel, r.base) >= 38.0);
 }
 
+TEST_CASE("accel: a raw field's sheet of zero thickness (max(a, -a)) is proven empty, not marched through", "[accel]") {
+    // 36 balls and, behind them, the sheet z = -0.7 that a union with max(a, -a) = |a|
+    // leaves (as coincident faces of a CSG model do): the field touches 0 there but never
+    // goes below, so the marches see no surface. The tree folds max(a, -a) into abs(a), whose
+    // interval is not negative: the sheet's cells count as empty (tape_tree.cpp kSheet), the
+    // rays jump over them, and the picture is the balls' alone.
+    std::string balls = "x var-x\ny var-y\nz var-z\nz2 square z\nrad const 0.1\n";
+    for (int i = 0; i < 36; ++i) {
+        const std::string n = std::to_string(i);
+        balls += "cx" + n + " const " + std::to_string(-0.75 + 0.3 * (i % 6)) + "\ncy" + n + " const " + std::to_string(-0.75 + 0.3 * (i / 6)) +
+                 "\ndx" + n + " sub x cx" + n + "\ndy" + n + " sub y cy" + n + "\nxx" + n + " square dx" + n + "\nyy" + n + " square dy" + n +
+                 "\ns" + n + " add xx" + n + " yy" + n + "\nt" + n + " add s" + n + " z2\nr" + n + " sqrt t" + n + "\nb" + n + " sub r" + n + " rad\n" +
+                 "u" + n + " min b" + n + " " + (i == 0 ? "b0" : "u" + std::to_string(i - 1)) + "\n";
+    }
+    const std::string sheet = balls + "c const 0.7\na add z c\nna neg a\nsh max a na\no min u35 sh\n";
+    SourceManager sm;
+    CompiledScene with = compile_scene(load_vm(sm, sm.add("sheet.vm", sheet)));
+    CompiledScene without = compile_scene(load_vm(sm, sm.add("balls.vm", balls)));
+    for (CompiledScene* cs : {&with, &without}) cs->render.width = 160, cs->render.height = 120;
+    cpu::TapeTree T;
+    cpu::build_tree(T, with.distance, glm::vec3(-1), glm::vec3(1), 0.0f, false, 160 * 120);
+    REQUIRE(T.active);
+    for (const glm::vec3 p : {glm::vec3(0.8f, 0.8f, -0.7f), glm::vec3(-0.9f, 0.1f, -0.7f), glm::vec3(0.0f, -0.85f, -0.7f)}) {
+        const cpu::TapeTree::Leaf& L = T.leaves[T.locate(p.x, p.y, p.z)];
+        INFO("leaf at " << p.x << ", " << p.y << ", " << p.z << ": [" << L.ivlo << ", " << L.ivhi << "]");
+        CHECK(L.ivlo > 0.0f);
+    }
+    RenderOptions ro;
+    ro.threads = 2;
+    RenderStats sw, so;
+    const Image a = render(with, ro, &sw), b = render(without, ro, &so);
+    INFO("points " << sw.distance_points << " / " << so.distance_points << ", skips " << sw.skips << " / " << so.skips << ", psnr "
+                   << psnr(a, b));
+    CHECK(psnr(a, b) >= 45.0);
+    CHECK(sw.distance_points < so.distance_points * 5 / 4);
+}
+
 TEST_CASE("accel: a leaf's ropes lead to its neighbours, and lookups through them find the point's leaf", "[accel]") {
     // A raw field's deep tree over 144 spheres: every leaf's rope across each face is a node
     // at least as big as the leaf whose box touches that face and covers it (or the root
