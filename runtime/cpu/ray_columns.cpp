@@ -19,6 +19,113 @@ namespace {
 constexpr int kMaxCells = 1024;
 constexpr size_t kMaxEntries = size_t(4) << 20;
 
+// A leaf's box (margins included) and the rectangle of cells [u0, u1] x [v0, v1] that holds
+// its projection; [s0, s1], the depths its box spans.
+struct Span {
+    float s0, s1;
+    int u0, u1, v0, v1;
+    glm::vec3 lo, hi;
+};
+
+// Each column gets the span's depths in every cell of its rectangle: in the order of their
+// starts, so that each column's runs come sorted and merge as they arrive; one pass counts
+// the merged runs, the next writes them. (A camera's columns: the boxes seen from the eye.)
+void lay_spans(RayColumns& c, std::vector<Span>& spans) {
+    const size_t columns = size_t(c.nu) * size_t(c.nv);
+    std::sort(spans.begin(), spans.end(), [](const Span& p, const Span& q) { return p.s0 < q.s0; });
+    auto each_cell = [&](const Span& S, auto&& fn) {  // fn(column) for the cells of S's rectangle
+        for (int y = S.v0; y <= S.v1; ++y)
+            for (size_t k = size_t(y) * c.nu + S.u0, ke = size_t(y) * c.nu + S.u1; k <= ke; ++k) fn(k);
+    };
+    std::vector<float> end(columns, -INFINITY);
+    std::vector<uint32_t> start(columns + 1, 0);
+    for (const Span& S : spans)
+        each_cell(S, [&](size_t k) {
+            start[k + 1] += S.s0 > end[k];
+            end[k] = std::max(end[k], S.s1);
+        });
+    // Room for each column's runs and its end mark, after the empty columns' mark.
+    for (size_t k = 0; k < columns; ++k) start[k + 1] += start[k] + (start[k + 1] > 0);
+    const glm::vec2 mark(INFINITY, INFINITY);
+    c.runs.assign(start[columns] + 1, mark);
+    c.first.resize(columns);
+    std::vector<uint32_t> next(columns);
+    for (size_t k = 0; k < columns; ++k) {
+        const bool empty = start[k + 1] == start[k];
+        c.first[k] = empty ? 0 : start[k] + 1;
+        next[k] = c.first[k];
+    }
+    for (const Span& S : spans)
+        each_cell(S, [&](size_t k) {
+            if (next[k] > c.first[k] && S.s0 <= c.runs[next[k] - 1].y) c.runs[next[k] - 1].y = std::max(c.runs[next[k] - 1].y, S.s1);
+            else c.runs[next[k]++] = glm::vec2(S.s0, S.s1);
+        });
+}
+
+// Parallel rays: in each cell of its rectangle a box spans only its chord along the rays
+// through the cell, far less than its whole depth for a box seen aslant (a shadow ray
+// leaving a surface then leaves its run with the surface's own leaves). Each slab of the box
+// bounds the chord: a point of the cell (its centre cu, cv +- half, margin g included) at
+// depth w is cu u + cv v + w dir, and the slab's entry and exit, linear across the cell,
+// are least and greatest at its corners. The chords are gathered by column (a counting
+// sort), then each column's sorted and merged.
+void lay_chords(RayColumns& c, const std::vector<Span>& spans, float g) {
+    const size_t columns = size_t(c.nu) * size_t(c.nv);
+    const double cell = 1.0 / double(c.inv_cell), half = 0.5 * cell + double(g);
+    const glm::dvec3 U(c.u), V(c.v), D(c.dir);
+    glm::dvec3 spread, inv;  // per axis: how far a cell's points move it, 1 / D (0: across the rays)
+    for (int a = 0; a < 3; ++a) spread[a] = half * (std::abs(U[a]) + std::abs(V[a])), inv[a] = std::abs(D[a]) > 1e-6 ? 1.0 / D[a] : 0.0;
+    struct Chord {
+        uint32_t column;
+        glm::vec2 run;
+    };
+    size_t cells = 0;
+    for (const Span& S : spans) cells += size_t(S.u1 - S.u0 + 1) * size_t(S.v1 - S.v0 + 1);
+    std::vector<Chord> chords;
+    chords.reserve(cells);
+    for (const Span& S : spans)
+        for (int y = S.v0; y <= S.v1; ++y)
+            for (int x = S.u0; x <= S.u1; ++x) {
+                const double cu = double(c.u0) + (x + 0.5) * cell, cv = double(c.v0) + (y + 0.5) * cell;
+                double lo = S.s0, hi = S.s1;
+                bool meets = true;
+                for (int a = 0; a < 3; ++a) {
+                    const double mid = cu * U[a] + cv * V[a], cmin = mid - spread[a], cmax = mid + spread[a];
+                    if (inv[a] > 0.0) lo = std::max(lo, (S.lo[a] - cmax) * inv[a]), hi = std::min(hi, (S.hi[a] - cmin) * inv[a]);
+                    else if (inv[a] < 0.0) lo = std::max(lo, (S.hi[a] - cmin) * inv[a]), hi = std::min(hi, (S.lo[a] - cmax) * inv[a]);
+                    else meets = meets && cmax >= S.lo[a] && cmin <= S.hi[a];  // (the slab holds the cell or not)
+                }
+                if (meets && lo <= hi) chords.push_back(Chord{uint32_t(size_t(y) * c.nu + size_t(x)), glm::vec2(float(lo) - g, float(hi) + g)});
+            }
+    std::vector<uint32_t> at(columns + 1, 0);
+    for (const Chord& h : chords) ++at[h.column + 1];
+    for (size_t k = 0; k < columns; ++k) at[k + 1] += at[k];
+    std::vector<glm::vec2> all(chords.size());
+    {
+        std::vector<uint32_t> next(at.begin(), at.end() - 1);
+        for (const Chord& h : chords) all[next[h.column]++] = h.run;
+    }
+    const glm::vec2 mark(INFINITY, INFINITY);
+    c.runs.assign(1, mark);  // (the empty columns' mark)
+    c.runs.reserve(chords.size() + 1);
+    c.first.assign(columns, 0);
+    for (size_t k = 0; k < columns; ++k) {
+        glm::vec2* r = all.data() + at[k];
+        const uint32_t n = at[k + 1] - at[k];
+        if (n == 0) continue;
+        for (uint32_t j = 1; j < n; ++j)  // (insertion: a column holds a few)
+            for (uint32_t i = j; i > 0 && r[i].x < r[i - 1].x; --i) std::swap(r[i], r[i - 1]);
+        c.first[k] = uint32_t(c.runs.size());
+        glm::vec2 cur = r[0];
+        for (uint32_t j = 1; j < n; ++j) {
+            if (r[j].x <= cur.y) cur.y = std::max(cur.y, r[j].y);
+            else c.runs.push_back(cur), cur = r[j];
+        }
+        c.runs.push_back(cur);
+        c.runs.push_back(mark);
+    }
+}
+
 }  // namespace
 
 std::shared_ptr<const RayColumns> build_ray_columns(const TapeTree& T, const ColumnsKey& key) {
@@ -59,6 +166,7 @@ std::shared_ptr<const RayColumns> build_ray_columns(const TapeTree& T, const Col
     // Each leaf's rectangle in the plane of the cells, and the run of depth its box spans.
     struct Proj {
         float a0, a1, b0, b1, s0, s1;
+        glm::vec3 lo{0}, hi{0};  // the box, margins included
     };
     std::vector<Proj> proj;
     proj.reserve(full.size());
@@ -126,7 +234,7 @@ std::shared_ptr<const RayColumns> build_ray_columns(const TapeTree& T, const Col
             const float pu = glm::dot(m, c.u), hu = glm::dot(h, au) + g;
             const float pv = glm::dot(m, c.v), hv = glm::dot(h, av) + g;
             const float ps = glm::dot(m, c.dir), hs = glm::dot(h, ad) + g;
-            P = Proj{pu - hu, pu + hu, pv - hv, pv + hv, ps - hs, ps + hs};
+            P = Proj{pu - hu, pu + hu, pv - hv, pv + hv, ps - hs, ps + hs, lo, hi};
         }
         P.a0 = std::max(P.a0, plo_u), P.a1 = std::min(P.a1, phi_u), P.b0 = std::max(P.b0, plo_v), P.b1 = std::min(P.b1, phi_v);
         if (!(P.a0 <= P.a1 && P.b0 <= P.b1 && P.s0 <= P.s1)) continue;  // (no column of the family meets it; NaN)
@@ -153,49 +261,15 @@ std::shared_ptr<const RayColumns> build_ray_columns(const TapeTree& T, const Col
     c.inv_cell = 1.0f / cell;
     c.nu = std::clamp(int(std::ceil(span_u * c.inv_cell)) + 1, 1, kMaxCells + 2);
     c.nv = std::clamp(int(std::ceil(span_v * c.inv_cell)) + 1, 1, kMaxCells + 2);
-    const size_t columns = size_t(c.nu) * size_t(c.nv);
 
-    // The leaves' rectangles of cells, in the order of their runs' starts, so that each
-    // column's runs come sorted and merge as they arrive: one pass counts the merged runs,
-    // the next writes them.
-    struct Span {
-        float s0, s1;
-        int u0, u1, v0, v1;
-    };
     std::vector<Span> spans;
     spans.reserve(proj.size());
     auto cell_of = [](float x, float x0, float inv, int n) { return std::clamp(int(std::floor((x - x0) * inv)), 0, n - 1); };
     for (const Proj& P : proj)
         spans.push_back(Span{P.s0, P.s1, cell_of(P.a0, c.u0, c.inv_cell, c.nu), cell_of(P.a1, c.u0, c.inv_cell, c.nu),
-                             cell_of(P.b0, c.v0, c.inv_cell, c.nv), cell_of(P.b1, c.v0, c.inv_cell, c.nv)});
-    std::sort(spans.begin(), spans.end(), [](const Span& p, const Span& q) { return p.s0 < q.s0; });
-    auto each_cell = [&](const Span& S, auto&& fn) {  // fn(column) for the cells of S's rectangle
-        for (int y = S.v0; y <= S.v1; ++y)
-            for (size_t k = size_t(y) * c.nu + S.u0, ke = size_t(y) * c.nu + S.u1; k <= ke; ++k) fn(k);
-    };
-    std::vector<float> end(columns, -INFINITY);
-    std::vector<uint32_t> start(columns + 1, 0);
-    for (const Span& S : spans)
-        each_cell(S, [&](size_t k) {
-            start[k + 1] += S.s0 > end[k];
-            end[k] = std::max(end[k], S.s1);
-        });
-    // Room for each column's runs and its end mark, after the empty columns' mark.
-    for (size_t k = 0; k < columns; ++k) start[k + 1] += start[k] + (start[k + 1] > 0);
-    const glm::vec2 mark(INFINITY, INFINITY);
-    c.runs.assign(start[columns] + 1, mark);
-    c.first.resize(columns);
-    std::vector<uint32_t> next(columns);
-    for (size_t k = 0; k < columns; ++k) {
-        const bool empty = start[k + 1] == start[k];
-        c.first[k] = empty ? 0 : start[k] + 1;
-        next[k] = c.first[k];
-    }
-    for (const Span& S : spans)
-        each_cell(S, [&](size_t k) {
-            if (next[k] > c.first[k] && S.s0 <= c.runs[next[k] - 1].y) c.runs[next[k] - 1].y = std::max(c.runs[next[k] - 1].y, S.s1);
-            else c.runs[next[k]++] = glm::vec2(S.s0, S.s1);
-        });
+                             cell_of(P.b0, c.v0, c.inv_cell, c.nv), cell_of(P.b1, c.v0, c.inv_cell, c.nv), P.lo, P.hi});
+    if (c.central) lay_spans(c, spans);
+    else lay_chords(c, spans, g);
     return C;
 }
 
