@@ -24,7 +24,7 @@
 //    sign-change marching with refinement, hard shadows only, no AO, no cone tracing. A
 //    field that touches zero without going below (a sheet of zero thickness, which
 //    coincident faces of a CSG model leave) has no sign change: where the tree proves it
-//    not negative, rays jump as over empty space (tape_tree.cpp kSheet, segment_bounds).
+//    not negative, rays jump as over empty space (tape_tree.hpp kSheet, segment_bounds).
 //  * Tape tree: lanes evaluate their leaf's tape and jump over leaves proven empty
 //    (tape_tree.hpp); each march decides whether a jump is safe for it (its `skip`).
 //
@@ -38,7 +38,6 @@
 #endif
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "runtime/cpu/worker.hpp"
 
@@ -405,9 +404,7 @@ int Worker::segment_bounds(Lanes& L, const int32_t* lanes, int n) {
             for (int q = 0; q < c; ++q) {
                 const int i = lane[B.order[j0 + q]];
                 const Interval r = seg_iv_->result(q);
-                float lo = L.sign[i] > 0.0f ? r.lo : -r.hi;
-                const float hi = L.sign[i] > 0.0f ? r.hi : -r.lo;
-                if (lo >= 0.0f && hi > 0.0f) lo = std::max(lo, std::numeric_limits<float>::min());  // (a sheet at most: as tape_tree.cpp's kSheet)
+                const float lo = raw_floor(L.sign[i] > 0.0f ? r.lo : -r.hi, L.sign[i] > 0.0f ? r.hi : -r.lo);  // (a sheet at most: empty)
                 if (lo > 0.0f) L.seg[i] = lo, L.idx[proven++] = i;
             }
         }

@@ -20,7 +20,6 @@
 #include <tbb/parallel_for.h>
 
 #include <deque>
-#include <limits>
 #include <memory>
 #include <queue>
 
@@ -100,12 +99,6 @@ uint8_t split_axes(const TreeCell& c) {
     for (int a = 0; a < 3; ++a) axes |= uint8_t(e[a] >= 0.5f * m) << a;
     return axes ? axes : uint8_t(7);  // (NaN extents: all, as before)
 }
-
-// A raw field's cell whose values are proven not negative holds no sign change (at most
-// zeros: a sheet of zero thickness, which the marches do not take for a surface): its
-// lower bound is raised from 0 to kSheet, so that it counts as empty.
-constexpr float kSheet = std::numeric_limits<float>::min();
-float raw_floor(float lo, float hi) { return lo >= 0.0f && lo < kSheet && hi > 0.0f ? kSheet : lo; }
 
 // Empty (ivlo > 0) or solid (ivhi < 0): no surface inside.
 bool settled(float ivlo, float ivhi) { return ivlo > 0.0f || ivhi < 0.0f; }

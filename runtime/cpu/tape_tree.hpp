@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -25,6 +26,13 @@
 namespace sdfc::cpu {
 
 constexpr size_t kTreeMinProgram = 128;  // shorter programs get no tree (lookups would cost more)
+
+// A raw field's box whose values are proven not negative holds no sign change (at most
+// zeros: a sheet of zero thickness, which the marches do not take for a surface): its lower
+// bound [lo, hi] is raised from 0 to kSheet, so that it counts as empty (tree cells and
+// Worker::segment_bounds alike).
+constexpr float kSheet = std::numeric_limits<float>::min();
+inline float raw_floor(float lo, float hi) { return lo >= 0.0f && lo < kSheet && hi > 0.0f ? kSheet : lo; }
 
 struct TapeTree {
     static constexpr uint32_t kLeafBit = 0x80000000u;

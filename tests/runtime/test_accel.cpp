@@ -316,7 +316,7 @@ TEST_CASE("accel: a raw field's sheet of zero thickness (max(a, -a)) is proven e
     // 36 balls and, behind them, the sheet z = -0.7 that a union with max(a, -a) = |a|
     // leaves (as coincident faces of a CSG model do): the field touches 0 there but never
     // goes below, so the marches see no surface. The tree folds max(a, -a) into abs(a), whose
-    // interval is not negative: the sheet's cells count as empty (tape_tree.cpp kSheet), the
+    // interval is not negative: the sheet's cells count as empty (tape_tree.hpp kSheet), the
     // rays jump over them, and the picture is the balls' alone.
     std::string balls = "x var-x\ny var-y\nz var-z\nz2 square z\nrad const 0.1\n";
     for (int i = 0; i < 36; ++i) {
