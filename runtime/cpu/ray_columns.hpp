@@ -1,7 +1,8 @@
 // A family of rays' columns through the tape tree, for a raw field's marches
 // (Worker::march_raw): the rays of a directional light (parallel, along `dir`) or of a
 // pinhole camera (from its eye) are cut into columns, square cells across them, and each
-// column keeps the runs of depth along its rays where they may meet a leaf not proven empty.
+// column keeps the runs of depth along its rays where they may meet a leaf not proven empty
+// (a light's: less the pieces of those leaves proven positive, ray_columns.cpp lay_chords).
 // Every ray of the family stays inside one column, so a ray leaving an empty leaf (or a
 // leaf whose way it has proven clear) goes straight to the start of its column's next run:
 // nothing before it can hold a sign change. A ray past its column's last run is done.

@@ -501,6 +501,7 @@ void build_tree(TapeTree& T, const Program& p, glm::vec3 lo, glm::vec3 hi, float
     T.init_full(p);
     T.lo = lo;
     T.hi = hi;
+    T.time = time;
     T.active = true;
     TreeBuilder b(p, lo, hi, time, lipschitz, samples, thin_layer);
     bool worth_it = true;

@@ -84,6 +84,7 @@ struct TapeTree {
     std::vector<std::vector<Instr>> tapes;  // [0]: the full program
     std::vector<Guard> guards;  // the full program's (leaf 0's): the tree outlives the program it was built from (tree_cache.hpp)
     uint32_t max_regs = 1;
+    float time = 0.0f;  // the tapes' (a tree is built for one time: tree_cache.hpp)
     uint64_t boxes = 0;
     bool active = false;
 
