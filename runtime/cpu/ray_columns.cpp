@@ -94,10 +94,14 @@ struct Chord {
 };
 
 // Lays the chords of spans, one task's share of them: its own interval evaluator and list.
+// 1 / k for the pieces of a chord.
+constexpr double kInverse[kMaxPieces + 1] = {0.0, 1.0, 1.0 / 2, 1.0 / 3, 1.0 / 4, 1.0 / 5, 1.0 / 6, 1.0 / 7, 1.0 / 8};
+
 class ChordLayer {
 public:
     ChordLayer(const RayColumns& c, const TapeTree& T, float g) : c_(c), T_(T), g_(g), iv_(T.max_regs, 64) {
         cell_ = 1.0 / double(c.inv_cell);
+        inv_piece_ = 1.0 / (kPiece * cell_);
         const double half = 0.5 * cell_ + double(g);
         for (int a = 0; a < 3; ++a) {
             U_[a] = c.u[a], V_[a] = c.v[a], D_[a] = c.dir[a];
@@ -131,19 +135,21 @@ public:
                 // Piece j spans depths lo + [j, j + 1] len; per axis its box is piece 0's moved
                 // by j steps, widened by the cell's spread and g twice (the depths' margin, and
                 // the rounding of these floats).
-                const int k = std::clamp(int(std::ceil((hi - lo) / (kPiece * cell_))), 1, kMaxPieces);
-                const double len = (hi - lo) / k;
-                float blo[3], bhi[3], step[3];
+                const int k = std::clamp(int(std::ceil((hi - lo) * inv_piece_)), 1, kMaxPieces);
+                const double len = (hi - lo) * kInverse[k];
+                float blo[3], bhi[3], step[3], at[kMaxPieces + 1];  // at: the pieces' ends
                 for (int ax = 0; ax < 3; ++ax) {
                     const double e0 = mid[ax] + lo * D_[ax], e1 = e0 + len * D_[ax], pad = spread_[ax] + 2.0 * double(g_);
                     blo[ax] = float(std::min(e0, e1) - pad), bhi[ax] = float(std::max(e0, e1) + pad), step[ax] = float(len * D_[ax]);
                 }
+                for (int j = 0; j < k; ++j) at[j] = float(lo + j * len);
+                at[k] = float(hi);
                 for (int j = 0; j < k; ++j) {
                     for (int ax = 0; ax < 3; ++ax) {
                         bx_[2 * ax][np_] = std::max(blo[ax] + float(j) * step[ax], S.lo[ax]);
                         bx_[2 * ax + 1][np_] = std::min(bhi[ax] + float(j) * step[ax], S.hi[ax]);
                     }
-                    piece_[np_++] = Chord{column, glm::vec2(float(lo + j * len) - g_, float(j + 1 == k ? hi : lo + (j + 1) * len) + g_)};
+                    piece_[np_++] = Chord{column, glm::vec2(at[j] - g_, at[j + 1] + g_)};
                     if (np_ == kIvLanes) prove();
                 }
             }
@@ -168,7 +174,7 @@ private:
     const RayColumns& c_;
     const TapeTree& T_;
     const float g_;
-    double cell_, U_[3], V_[3], D_[3], spread_[3], inv_[3];  // spread: how far a cell's points move an axis; inv: 1 / D (0: across the rays)
+    double cell_, inv_piece_, U_[3], V_[3], D_[3], spread_[3], inv_[3];  // spread: how far a cell's points move an axis; inv: 1 / D (0: across the rays)
     IntervalEvaluator iv_;
     const TapeTree::Leaf* leaf_ = nullptr;
     alignas(64) float bx_[6][kIvLanes];
@@ -194,26 +200,22 @@ void lay_chords(RayColumns& c, const std::vector<Span>& spans, float g, const Ta
         ChordLayer& layer = layers.local();
         for (size_t i = r.begin(); i != r.end(); ++i) layer.lay(spans[i]);
     });
-    size_t total = 0;
-    for (const ChordLayer& layer : layers) total += layer.chords.size();
-    std::vector<Chord> chords;
-    chords.reserve(total);
-    for (const ChordLayer& layer : layers) chords.insert(chords.end(), layer.chords.begin(), layer.chords.end());
+    // (counted, then placed: afterwards at[k] is where column k's chords end, column k - 1's
+    // where they begin)
     std::vector<uint32_t> at(columns + 1, 0);
-    for (const Chord& h : chords) ++at[h.column + 1];
+    for (const ChordLayer& layer : layers)
+        for (const Chord& h : layer.chords) ++at[h.column + 1];
     for (size_t k = 0; k < columns; ++k) at[k + 1] += at[k];
-    std::vector<glm::vec2> all(chords.size());
-    {
-        std::vector<uint32_t> next(at.begin(), at.end() - 1);
-        for (const Chord& h : chords) all[next[h.column]++] = h.run;
-    }
+    std::vector<glm::vec2> all(at[columns]);
+    for (const ChordLayer& layer : layers)
+        for (const Chord& h : layer.chords) all[at[h.column]++] = h.run;
     const glm::vec2 mark(INFINITY, INFINITY);
     c.runs.assign(1, mark);  // (the empty columns' mark)
-    c.runs.reserve(chords.size() + 1);
     c.first.assign(columns, 0);
     for (size_t k = 0; k < columns; ++k) {
-        glm::vec2* r = all.data() + at[k];
-        const uint32_t n = at[k + 1] - at[k];
+        const uint32_t begin = k == 0 ? 0 : at[k - 1];
+        glm::vec2* r = all.data() + begin;
+        const uint32_t n = at[k] - begin;
         if (n == 0) continue;
         for (uint32_t j = 1; j < n; ++j)  // (insertion: a column holds a few)
             for (uint32_t i = j; i > 0 && r[i].x < r[i - 1].x; --i) std::swap(r[i], r[i - 1]);
