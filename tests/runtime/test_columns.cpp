@@ -5,21 +5,19 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "lang/load.hpp"
 #include "runtime/cpu/frame.hpp"
 #include "runtime/cpu/ray_columns.hpp"
 #include "runtime/cpu/tape_tree.hpp"
 #include "runtime/cpu/tracer.hpp"
 #include "runtime/eval/interval.hpp"
+#include "shared_models.hpp"
 #include "support.hpp"
 
 using namespace sdfc;
-namespace fs = std::filesystem;
 
 namespace {
 
@@ -297,13 +295,9 @@ TEST_CASE("columns: an orthographic camera's rays are carried along parallel col
 TEST_CASE("columns: colonnade.vm's lights carry no ray past a point where the field may change sign", "[columns]") {
     // A public model of planes and cylinders (../shared), its tree and lights as a 1024^2
     // render makes them: 3,000 rays along each directional light from points all over the root.
-    const fs::path path = fs::path(SDFC_SHARED_DIR) / "bench" / "vm" / "colonnade.vm";
-    if (!fs::exists(path)) {
-        WARN("skipped: " << path << " is absent");
-        return;
-    }
-    SourceManager sm;
-    CompiledScene cs = compile_scene(load_scene(sm, path.string()));
+    const auto model = test::shared_model("colonnade.vm");
+    if (!model) return;
+    CompiledScene& cs = model->cs;
     cs.render.width = 1024, cs.render.height = 1024;
     const RenderOptions ro;
     const cpu::Frame f = cpu::make_frame(cs, ro);

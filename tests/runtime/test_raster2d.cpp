@@ -2,7 +2,6 @@
 // pixel for pixel, to brute-force evaluation of the same file.
 #include <catch2/catch.hpp>
 
-#include <filesystem>
 #include <random>
 #include <thread>
 #include <vector>
@@ -12,23 +11,18 @@
 #include "compiler/bytecode/compile.hpp"
 #include "lang/load.hpp"
 #include "runtime/cpu/slice.hpp"
+#include "shared_models.hpp"
 
 using namespace sdfc;
-namespace fs = std::filesystem;
 
 namespace {
 
 // threads: 0 for all cores; more than 4 runs the quadtree's second level as tasks too
 // (Ctx::nested in raster2d.cpp), each making its own tape (simplify_lane).
 void check_identical(const std::string& name, int w, int h, int threads = 0) {
-    const fs::path path = fs::path(SDFC_SHARED_DIR) / "bench" / "vm" / name;
-    if (!fs::exists(path)) {
-        WARN("skipped: " << path << " is absent");
-        return;
-    }
-    SourceManager sm;
-    Scene s = load_scene(sm, path.string());
-    CompiledScene cs = compile_scene(s);
+    const auto model = test::shared_model(name);
+    if (!model) return;
+    const CompiledScene& cs = model->cs;
     REQUIRE(cs.is_2d);
     RenderStats fast_stats, brute_stats;
     Image fast = render_2d(cs, w, h, threads, false, &fast_stats);
@@ -132,13 +126,9 @@ TEST_CASE("render_2d: a sign decision keeps a NaN operand's NaN (max(x, max(ln x
 }
 
 TEST_CASE("Raster2d: a prepared model draws the same image every time, from several threads at once") {
-    const fs::path path = fs::path(SDFC_SHARED_DIR) / "bench" / "vm" / "prospero.vm";
-    if (!fs::exists(path)) {
-        WARN("skipped: " << path << " is absent");
-        return;
-    }
-    SourceManager sm;
-    CompiledScene cs = compile_scene(load_scene(sm, path.string()));
+    const auto model = test::shared_model("prospero.vm");
+    if (!model) return;
+    const CompiledScene& cs = model->cs;
     RenderStats once;
     const Image expect = render_2d(cs, 512, 384, 2, false, &once);
     const Raster2d raster(cs);
