@@ -77,26 +77,17 @@ void lay_spans(RayColumns& c, std::vector<Span>& spans) {
         });
 }
 
-// Parallel rays: in each cell of its rectangle a box spans only its chord along the rays
-// through the cell, far less than its whole depth for a box seen aslant (a shadow ray
-// leaving a surface then leaves its run with the surface's own leaves). Each slab of the box
-// bounds the chord: a point of the cell (its centre cu, cv +- half, margin g included) at
-// depth w is cu u + cv v + w dir, and the slab's entry and exit, linear across the cell,
-// are least and greatest at its corners. A chord is cut into pieces about a cell long, and
-// a piece whose box (the cell's points over its depths, within the leaf's box) the leaf's
-// tape proves positive is left out (no sign change in it; a sheet counts as positive, as in
-// the tree): a shadow ray leaving a surface is then past its column's run once it is past
-// the surface's piece, not the whole layer of the surface's leaves. The chords are gathered
-// by column (a counting sort), then each column's sorted and merged.
+// Depths [run.x, run.y] along the rays of one column.
 struct Chord {
     uint32_t column;
     glm::vec2 run;
 };
 
-// Lays the chords of spans, one task's share of them: its own interval evaluator and list.
 // 1 / k for the pieces of a chord.
 constexpr double kInverse[kMaxPieces + 1] = {0.0, 1.0, 1.0 / 2, 1.0 / 3, 1.0 / 4, 1.0 / 5, 1.0 / 6, 1.0 / 7, 1.0 / 8};
 
+// Lays the chords of spans (lay_chords), one task's share of them: its own interval
+// evaluator and list.
 class ChordLayer {
 public:
     ChordLayer(const RayColumns& c, const TapeTree& T, float g) : c_(c), T_(T), g_(g), iv_(T.max_regs, 64) {
@@ -339,7 +330,7 @@ std::shared_ptr<const RayColumns> build_ray_columns(const TapeTree& T, const Col
             const float pu = glm::dot(m, c.u), hu = glm::dot(h, au) + g;
             const float pv = glm::dot(m, c.v), hv = glm::dot(h, av) + g;
             const float ps = glm::dot(m, c.dir), hs = glm::dot(h, ad) + g;
-            P = Proj{pu - hu, pu + hu, pv - hv, pv + hv, ps - hs, ps + hs, lo, hi, l};
+            P = Proj{pu - hu, pu + hu, pv - hv, pv + hv, ps - hs, ps + hs, lo, hi};
         }
         P.leaf = l;
         P.a0 = std::max(P.a0, plo_u), P.a1 = std::min(P.a1, phi_u), P.b0 = std::max(P.b0, plo_v), P.b1 = std::min(P.b1, phi_v);
