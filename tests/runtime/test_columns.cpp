@@ -49,15 +49,30 @@ struct SurfaceTest {
     const cpu::TapeTree& T;
     bool pointwise;
     IntervalEvaluator iv{T.max_regs, 64};
-    bool full_leaf(const glm::vec3& p) const { return !(T.leaves[T.locate(p.x, p.y, p.z)].ivlo > 0.0f); }
-    bool operator()(const glm::vec3& p) {
-        if (!full_leaf(p)) return false;
-        if (!pointwise) return true;
-        iv.eval(T.leaves[T.locate(p.x, p.y, p.z)].view(), &p.x, &p.x, &p.y, &p.y, &p.z, &p.z, 1, 0.0f);
+    struct Sample {
+        bool full_leaf;    // in a leaf not proven empty
+        bool may_change;   // the field may change sign at the point
+    };
+    Sample operator()(const glm::vec3& p) {
+        const cpu::TapeTree::Leaf& leaf = T.leaves[T.locate(p.x, p.y, p.z)];
+        const bool full = !(leaf.ivlo > 0.0f);
+        if (!full || !pointwise) return {full, full};
+        iv.eval(leaf.view(), &p.x, &p.x, &p.y, &p.y, &p.z, &p.z, 1, 0.0f);
         const Interval r = iv.result(0);
-        return !(cpu::raw_floor(r.lo, r.hi) > 0.0f);
+        return {true, !(cpu::raw_floor(r.lo, r.hi) > 0.0f)};
     }
 };
+
+// Where the ray o + t d is inside the box [lo, hi] shrunk by 1e-3 (a ray's end must be in
+// the root): [ta, tb].
+void clip_to_root(glm::vec3 lo, glm::vec3 hi, glm::vec3 o, glm::vec3 d, float& ta, float& tb) {
+    ta = -INFINITY, tb = INFINITY;
+    for (int k = 0; k < 3; ++k) {
+        if (d[k] == 0.0f) continue;  // (o is inside on that axis)
+        const float p = (lo[k] + 1e-3f - o[k]) / d[k], q = (hi[k] - 1e-3f - o[k]) / d[k];
+        ta = std::max(ta, std::min(p, q)), tb = std::min(tb, std::max(p, q));
+    }
+}
 
 // Along the ray o + t d over [t0, t1] (in the root), samples a 16th of the finest leaf
 // apart: from each, clear_until (the ray's place kept, as a march keeps it) must not pass a
@@ -66,10 +81,10 @@ void walk(SurfaceTest& surface, const cpu::RayColumns& C, glm::vec3 o, glm::vec3
     std::vector<float> ts;
     std::vector<char> full, in_full;
     for (float t = t0; t <= t1; t += h) {
-        const glm::vec3 p = o + d * t;
+        const SurfaceTest::Sample s = surface(o + d * t);
         ts.push_back(t);
-        full.push_back(surface(p));
-        in_full.push_back(surface.full_leaf(p));
+        full.push_back(s.may_change);
+        in_full.push_back(s.full_leaf);
     }
     std::vector<size_t> next_full(ts.size() + 1, ts.size());  // the first sample from j on in such a leaf
     for (size_t j = ts.size(); j-- > 0;) next_full[j] = full[j] ? j : next_full[j + 1];
@@ -132,14 +147,7 @@ TEST_CASE("columns: no ray is carried past a point where the field may change si
     cpu::build_tree(T, c->cs.distance, lo, hi, 0.0f, false, 160 * 90);
     REQUIRE(T.active);
     const float h = finest_leaf(T) / 16.0f;
-    // (a little inside the root: a ray's end must be in it)
-    auto clip = [&](glm::vec3 o, glm::vec3 d, float& ta, float& tb) {
-        ta = -INFINITY, tb = INFINITY;
-        for (int k = 0; k < 3; ++k) {
-            const float p = (lo[k] + 1e-3f - o[k]) / d[k], q = (hi[k] - 1e-3f - o[k]) / d[k];
-            ta = std::max(ta, std::min(p, q)), tb = std::min(tb, std::max(p, q));
-        }
-    };
+    auto clip = [&](glm::vec3 o, glm::vec3 d, float& ta, float& tb) { clip_to_root(lo, hi, o, d, ta, tb); };
 
     SECTION("a directional light's rays, from points all over the root") {
         // Aslant, then straight down an axis and along a diagonal (the runs in a column are
@@ -320,9 +328,8 @@ TEST_CASE("columns: colonnade.vm's lights carry no ray past a point where the fi
         SurfaceTest surface{T, true};
         for (int r = 0; r < 3000; ++r) {
             const glm::vec3 o = lo + (hi - lo) * glm::vec3(uniform(), uniform(), uniform());
-            float tb = INFINITY;  // (where the ray leaves the root, a little inside it)
-            for (int k = 0; k < 3; ++k)
-                if (key.dir[k] != 0.0f) tb = std::min(tb, std::max((lo[k] + 1e-3f - o[k]) / key.dir[k], (hi[k] - 1e-3f - o[k]) / key.dir[k]));
+            float ta, tb;
+            clip_to_root(lo, hi, o, key.dir, ta, tb);
             walk(surface, *C, o, key.dir, 0.0f, tb, h, w);
         }
         INFO("light " << lights << ": rays " << w.rays << ", samples carried " << w.carried << ", in leaves not proven empty "
