@@ -64,12 +64,16 @@ struct SurfaceTest {
 };
 
 // Where the ray o + t d is inside the box [lo, hi] shrunk by 1e-3 (a ray's end must be in
-// the root): [ta, tb].
+// the root): [ta, tb], empty (ta > tb) where it misses it.
 void clip_to_root(glm::vec3 lo, glm::vec3 hi, glm::vec3 o, glm::vec3 d, float& ta, float& tb) {
     ta = -INFINITY, tb = INFINITY;
     for (int k = 0; k < 3; ++k) {
-        if (d[k] == 0.0f) continue;  // (o is inside on that axis)
-        const float p = (lo[k] + 1e-3f - o[k]) / d[k], q = (hi[k] - 1e-3f - o[k]) / d[k];
+        const float a = lo[k] + 1e-3f, b = hi[k] - 1e-3f;
+        if (d[k] == 0.0f) {
+            if (o[k] < a || o[k] > b) ta = INFINITY, tb = -INFINITY;
+            continue;
+        }
+        const float p = (a - o[k]) / d[k], q = (b - o[k]) / d[k];
         ta = std::max(ta, std::min(p, q)), tb = std::min(tb, std::max(p, q));
     }
 }
@@ -79,15 +83,15 @@ void clip_to_root(glm::vec3 lo, glm::vec3 hi, glm::vec3 o, glm::vec3 d, float& t
 // sample where the field may change sign.
 void walk(SurfaceTest& surface, const cpu::RayColumns& C, glm::vec3 o, glm::vec3 d, float t0, float t1, float h, Walk& w) {
     std::vector<float> ts;
-    std::vector<char> full, in_full;
+    std::vector<char> change, in_full;
     for (float t = t0; t <= t1; t += h) {
         const SurfaceTest::Sample s = surface(o + d * t);
         ts.push_back(t);
-        full.push_back(s.may_change);
+        change.push_back(s.may_change);
         in_full.push_back(s.full_leaf);
     }
-    std::vector<size_t> next_full(ts.size() + 1, ts.size());  // the first sample from j on in such a leaf
-    for (size_t j = ts.size(); j-- > 0;) next_full[j] = full[j] ? j : next_full[j + 1];
+    std::vector<size_t> next_change(ts.size() + 1, ts.size());  // the first sample from j on where the sign may change
+    for (size_t j = ts.size(); j-- > 0;) next_change[j] = change[j] ? j : next_change[j + 1];
     ++w.rays;
     uint32_t place = 0;
     for (size_t j = 0; j < ts.size(); ++j) {
@@ -95,7 +99,7 @@ void walk(SurfaceTest& surface, const cpu::RayColumns& C, glm::vec3 o, glm::vec3
         if (!(c >= ts[j])) FAIL_CHECK("clear_until(" << ts[j] << ") = " << c);
         if (c > ts[j]) ++w.carried, w.carried_in_full += in_full[j];
         if (c == INFINITY) ++w.to_end;
-        const size_t k = next_full[j];
+        const size_t k = next_change[j];
         if (k < ts.size() && ts[k] < c) {
             ++w.wrong;
             FAIL_CHECK("carried from t = " << ts[j] << " to " << c << " past t = " << ts[k] << " (the field may change sign there)");
