@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "compiler/render/rules.h"
 #include "runtime/cpu/frame.hpp"
 #include "runtime/cpu/ray_columns.hpp"
 #include "runtime/cpu/tape_tree.hpp"
@@ -64,18 +65,10 @@ struct SurfaceTest {
 };
 
 // Where the ray o + t d is inside the box [lo, hi] shrunk by 1e-3 (a ray's end must be in
-// the root): [ta, tb], empty (ta > tb) where it misses it.
+// the root): [ta, tb], as the renderers clip (ta = inf where the ray misses the box).
 void clip_to_root(glm::vec3 lo, glm::vec3 hi, glm::vec3 o, glm::vec3 d, float& ta, float& tb) {
     ta = -INFINITY, tb = INFINITY;
-    for (int k = 0; k < 3; ++k) {
-        const float a = lo[k] + 1e-3f, b = hi[k] - 1e-3f;
-        if (d[k] == 0.0f) {
-            if (o[k] < a || o[k] > b) ta = INFINITY, tb = -INFINITY;
-            continue;
-        }
-        const float p = (a - o[k]) / d[k], q = (b - o[k]) / d[k];
-        ta = std::max(ta, std::min(p, q)), tb = std::min(tb, std::max(p, q));
-    }
+    rules::sdf_clip_box(lo + 1e-3f, hi - 1e-3f, o, d, ta, tb);
 }
 
 // Along the ray o + t d over [t0, t1] (in the root), samples a 16th of the finest leaf
