@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# The default (portable) build runs on a baseline x86-64 CPU: sdfc under qemu-user's qemu64
+# CPU (SSE2/SSE3, no AVX: an AVX instruction outside the run-time dispatch stops it with an
+# illegal instruction) chooses the baseline kernels and draws every example, a 2D model and a
+# mesh bit for bit as this machine's best kernels do (tests/runtime/test_isa.cpp: the copies
+# compute the same floats). Exit 77 (ctest: skipped) without qemu-x86_64 (apt-get install
+# qemu-user) or on a CPU that is not x86-64.
+#   run.sh SOURCE_DIR SDFC_BINARY
+set -uo pipefail
+src=$1
+sdfc=$2
+[[ $(uname -m) == x86_64 ]] || { echo "SKIPPED: not an x86-64 machine"; exit 77; }
+command -v qemu-x86_64 >/dev/null || { echo "SKIPPED: no qemu-x86_64 (apt-get install qemu-user)"; exit 77; }
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+old() { qemu-x86_64 -cpu qemu64 "$sdfc" "$@"; }
+fail=0
+check() {  # check NAME FILE_A FILE_B
+    if cmp -s "$2" "$3"; then echo "ok: $1"; else echo "FAILED: $1 differs on the baseline CPU"; fail=1; fi
+}
+
+isa=$(old bench "$src/examples/lattice.sdf" --width 32 --height 18 --repeat 1 --warmup 0 | sed -n 's/.*isa=\([a-z0-9-]*\).*/\1/p')
+if [[ $isa != x86-64 ]]; then echo "FAILED: on qemu64 sdfc chose the kernels '$isa', not x86-64"; fail=1; fi
+
+for f in "$src"/examples/*.sdf; do
+    n=$(basename "$f" .sdf)
+    "$sdfc" render "$f" --width 128 --height 72 --threads 2 -o "$tmp/$n.here.png" --quiet || { echo "FAILED: $n (here)"; fail=1; continue; }
+    old render "$f" --width 128 --height 72 --threads 2 -o "$tmp/$n.old.png" --quiet || { echo "FAILED: $n on qemu64 (exit $?)"; fail=1; continue; }
+    check "$n.sdf" "$tmp/$n.here.png" "$tmp/$n.old.png"
+done
+
+vm=$src/../shared/bench/vm/prospero.vm
+if [[ -f $vm ]]; then
+    "$sdfc" render "$vm" --width 256 --height 256 -o "$tmp/p.here.png" --quiet &&
+        old render "$vm" --width 256 --height 256 -o "$tmp/p.old.png" --quiet &&
+        check prospero.vm "$tmp/p.here.png" "$tmp/p.old.png" || { echo "FAILED: prospero.vm"; fail=1; }
+fi
+
+"$sdfc" mesh "$src/examples/csg-tori.sdf" --resolution 48 -o "$tmp/m.here.stl" --quiet &&
+    old mesh "$src/examples/csg-tori.sdf" --resolution 48 -o "$tmp/m.old.stl" --quiet &&
+    check "csg-tori.sdf mesh" "$tmp/m.here.stl" "$tmp/m.old.stl" || { echo "FAILED: mesh"; fail=1; }
+exit $fail
