@@ -1,19 +1,21 @@
 #!/usr/bin/env bash
 # The default (portable) build runs on a baseline x86-64 CPU: sdfc under qemu-user's qemu64
-# CPU (SSE2/SSE3, no AVX: an AVX instruction outside the run-time dispatch stops it with an
-# illegal instruction) chooses the baseline kernels and draws every example, a 2D model and a
-# mesh bit for bit as this machine's best kernels do (tests/runtime/test_isa.cpp: the copies
-# compute the same floats). Exit 77 (ctest: skipped) without qemu-x86_64 (apt-get install
-# qemu-user) or on a CPU that is not x86-64.
+# CPU less SSE3, CMPXCHG16B and LAHF (x86-64-v1: SSE2, no AVX; qemu stops an instruction the
+# CPU lacks with an illegal instruction, so one outside the run-time dispatch fails the test)
+# chooses the baseline kernels and draws every example, a 2D model and a mesh bit for bit as
+# this machine's best kernels do (tests/runtime/test_isa.cpp: the copies compute the same
+# floats). Exit 77 (ctest: skipped) without qemu-x86_64 (apt-get install qemu-user) or on a
+# CPU that is not x86-64.
 #   run.sh SOURCE_DIR SDFC_BINARY
 set -uo pipefail
 src=$1
 sdfc=$2
 [[ $(uname -m) == x86_64 ]] || { echo "SKIPPED: not an x86-64 machine"; exit 77; }
 command -v qemu-x86_64 >/dev/null || { echo "SKIPPED: no qemu-x86_64 (apt-get install qemu-user)"; exit 77; }
+ulimit -c 0  # (a failing run leaves no core file)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-old() { qemu-x86_64 -cpu qemu64 "$sdfc" "$@"; }
+old() { qemu-x86_64 -cpu qemu64,-sse3,-cx16,-lahf-lm "$sdfc" "$@"; }
 fail=0
 check() {  # check NAME FILE_A FILE_B
     if cmp -s "$2" "$3"; then echo "ok: $1"; else echo "FAILED: $1 differs on the baseline CPU"; fail=1; fi
