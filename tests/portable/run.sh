@@ -17,28 +17,21 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 on_baseline_cpu() { qemu-x86_64 -cpu qemu64,-sse3,-cx16,-lahf-lm "$sdfc" "$@"; }
 fail=0
-check() {  # check NAME FILE_A FILE_B
-    if cmp -s "$2" "$3"; then echo "ok: $1"; else echo "FAILED: $1 differs on the baseline CPU"; fail=1; fi
+same() {  # same NAME EXT ARGS...: `sdfc ARGS -o FILE.EXT` here and on the baseline CPU, byte for byte
+    local name=$1 here=$tmp/$1.here.$2 there=$tmp/$1.baseline.$2
+    shift 2
+    "$sdfc" "$@" -o "$here" --quiet || { echo "FAILED: $name (here)"; fail=1; return; }
+    on_baseline_cpu "$@" -o "$there" --quiet || { echo "FAILED: $name on the baseline CPU (exit $?)"; fail=1; return; }
+    if cmp -s "$here" "$there"; then echo "ok: $name"; else echo "FAILED: $name differs on the baseline CPU"; fail=1; fi
 }
 
 isa=$(on_baseline_cpu bench "$src/examples/lattice.sdf" --width 32 --height 18 --repeat 1 --warmup 0 | sed -n 's/.*isa=\([a-z0-9-]*\).*/\1/p')
 if [[ $isa != x86-64 ]]; then echo "FAILED: on the baseline CPU sdfc chose the kernels '$isa', not x86-64"; fail=1; fi
 
 for f in "$src"/examples/*.sdf; do
-    n=$(basename "$f" .sdf)
-    "$sdfc" render "$f" --width 128 --height 72 --threads 2 -o "$tmp/$n.here.png" --quiet || { echo "FAILED: $n (here)"; fail=1; continue; }
-    on_baseline_cpu render "$f" --width 128 --height 72 --threads 2 -o "$tmp/$n.baseline.png" --quiet || { echo "FAILED: $n on the baseline CPU (exit $?)"; fail=1; continue; }
-    check "$n.sdf" "$tmp/$n.here.png" "$tmp/$n.baseline.png"
+    same "$(basename "$f")" png render "$f" --width 128 --height 72 --threads 2
 done
-
 vm=$src/../shared/bench/vm/prospero.vm
-if [[ -f $vm ]]; then
-    "$sdfc" render "$vm" --width 256 --height 256 -o "$tmp/p.here.png" --quiet &&
-        on_baseline_cpu render "$vm" --width 256 --height 256 -o "$tmp/p.baseline.png" --quiet &&
-        check prospero.vm "$tmp/p.here.png" "$tmp/p.baseline.png" || { echo "FAILED: prospero.vm"; fail=1; }
-fi
-
-"$sdfc" mesh "$src/examples/csg-tori.sdf" --resolution 48 -o "$tmp/m.here.stl" --quiet &&
-    on_baseline_cpu mesh "$src/examples/csg-tori.sdf" --resolution 48 -o "$tmp/m.baseline.stl" --quiet &&
-    check "csg-tori.sdf mesh" "$tmp/m.here.stl" "$tmp/m.baseline.stl" || { echo "FAILED: mesh"; fail=1; }
+[[ -f $vm ]] && same prospero.vm png render "$vm" --width 256 --height 256
+same "csg-tori.sdf mesh" stl mesh "$src/examples/csg-tori.sdf" --resolution 48
 exit $fail
